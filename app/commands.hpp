@@ -1,0 +1,26 @@
+#pragma once
+// Each `nelf` subcommand lives in its own app/cmd_*.cpp and registers itself here.
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <stdexcept>
+
+namespace nelf::app {
+
+// A problem with how nelf was invoked or with its input; main() prints what() as one line and
+// exits with `status` (2 for bad arguments or profiles, 1 for failed jobs).
+class UserError : public std::runtime_error {
+ public:
+  explicit UserError(const std::string& message, int status = 1) : std::runtime_error(message), status_(status) {}
+  int status() const { return status_; }
+
+ private:
+  int status_;
+};
+
+// Adds a subcommand to `app`. The callback it installs is run after parsing; it may throw.
+using CommandRegistrar = void (*)(CLI::App& app);
+
+void add_profiles_command(CLI::App& app);
+void add_design_command(CLI::App& app);
+
+}  // namespace nelf::app

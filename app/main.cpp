@@ -1,0 +1,47 @@
+// nelf: shows stereo content on near-eye light field displays. See README.md.
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "app/commands.hpp"
+#include "compositor/profile.hpp"
+
+namespace {
+
+constexpr nelf::app::CommandRegistrar registrars[] = {
+    nelf::app::add_profiles_command,
+    nelf::app::add_design_command,
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"nelf: watch 3D movies and play stereo games on near-eye light field displays", "nelf"};
+  app.set_version_flag("--version", fmt::format("nelf {}", NELF_VERSION));
+  app.require_subcommand(1);
+  for (auto add : registrars) add(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // One line, the way a user can act on it, and the conventional usage-error status.
+    fmt::print(stderr, "nelf: {} (see nelf --help)\n", e.what());
+    return 2;
+  } catch (const nelf::ProfileError& e) {
+    fmt::print(stderr, "nelf: {}\n", e.what());
+    return 2;
+  } catch (const nelf::app::UserError& e) {
+    fmt::print(stderr, "nelf: {}\n", e.what());
+    return e.status();
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "nelf: error: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,43 @@
+#pragma once
+// Helpers shared by the tests: temporary directories, running the nelf binary, small profiles.
+#include <filesystem>
+#include <string>
+
+namespace nelf::test {
+
+// A fresh directory under the system temp dir, removed with everything in it on destruction.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// Writes `text` to `path` (creating or replacing it).
+void write_file(const std::filesystem::path& path, const std::string& text);
+std::string read_file(const std::filesystem::path& path);
+
+struct CommandResult {
+  int status = -1;  // exit status, or 128 + signal number when killed by a signal
+  std::string out;
+  std::string err;
+};
+
+// Runs a shell command line (through /bin/sh), capturing stdout and stderr separately.
+CommandResult run_command(const std::string& command_line);
+
+#ifdef NELF_BINARY
+// Runs `nelf ARGS` (ARGS is a shell-quoted string).
+inline CommandResult run_nelf(const std::string& args) { return run_command(std::string(NELF_BINARY) + " " + args); }
+#endif
+
+// Quotes a string for /bin/sh.
+std::string shell_quote(const std::string& s);
+
+}  // namespace nelf::test
