@@ -16,6 +16,12 @@ Vec2 rotate(Vec2 v, double angle) {
   return {c * v.x - s * v.y, s * v.x + c * v.y};
 }
 
+// Rotation by the mapping's angle (sign = +1) or its inverse (sign = -1), without trigonometry per pixel.
+Vec2 rotate(const EyeMapping& m, Vec2 v, double sign) {
+  const double c = m.rotation_cos, s = sign * m.rotation_sin;
+  return {c * v.x - s * v.y, s * v.x + c * v.y};
+}
+
 double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
 optics::AxisGeometry axis_geometry(const Profile& p, int axis) {
@@ -60,6 +66,8 @@ EyeMapping make_eye_mapping(const Profile& profile, Eye eye, double content_aspe
   if (!m.has_lens_array) {
     // Stock device: the view fills the panel with its aspect kept, centred (letter/pillar-boxed).
     m.rotation_rad = radians(cal.rotation_deg);
+    m.rotation_cos = std::cos(m.rotation_rad);
+    m.rotation_sin = std::sin(m.rotation_rad);
     const double w = profile.display.width_mm(), h = profile.display.height_mm();
     if (content_aspect >= w / h)
       m.view_size_mm = {w, w / content_aspect};
@@ -70,6 +78,8 @@ EyeMapping make_eye_mapping(const Profile& profile, Eye eye, double content_aspe
 
   const LensArraySpec& lens = *profile.lens_array;
   m.rotation_rad = radians(lens.rotation_deg + cal.rotation_deg);
+  m.rotation_cos = std::cos(m.rotation_rad);
+  m.rotation_sin = std::sin(m.rotation_rad);
   m.eye_relief_mm = profile.viewing.eye_relief_mm;
   m.gap_mm = lens_gap_mm(profile);
   m.render_distance_mm = render_distance_mm(profile);
@@ -116,21 +126,21 @@ Vec2 display_position_mm(const EyeMapping& m, double x, double y) {
 std::optional<Vec2> owner_lens_centre(const EyeMapping& m, Vec2 s) {
   // Each lens's elemental image is the lens lattice projected from the pupil onto the display.
   const double to_lens_plane = m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm);
-  const Vec2 q = rotate({s.x * to_lens_plane - m.lattice_offset_mm.x, s.y * to_lens_plane - m.lattice_offset_mm.y},
-                        -m.rotation_rad);
+  const Vec2 q =
+      rotate(m, {s.x * to_lens_plane - m.lattice_offset_mm.x, s.y * to_lens_plane - m.lattice_offset_mm.y}, -1.0);
   const int lens_m = static_cast<int>(std::floor(q.x / m.lens_pitch_mm + 0.5));
   const int lens_n = static_cast<int>(std::floor(q.y / m.lens_pitch_mm + 0.5));
   if (lens_m < m.first_lens[0] || lens_m >= m.first_lens[0] + m.lenses[0] || lens_n < m.first_lens[1] ||
       lens_n >= m.first_lens[1] + m.lenses[1])
     return std::nullopt;
-  const Vec2 c = rotate({lens_m * m.lens_pitch_mm, lens_n * m.lens_pitch_mm}, m.rotation_rad);
+  const Vec2 c = rotate(m, {lens_m * m.lens_pitch_mm, lens_n * m.lens_pitch_mm}, 1.0);
   return Vec2{m.lattice_offset_mm.x + c.x, m.lattice_offset_mm.y + c.y};
 }
 
 std::optional<Vec2> view_coordinate(const EyeMapping& m, Vec2 s) {
   Vec2 uv;
   if (!m.has_lens_array) {
-    const Vec2 r = rotate(s, -m.rotation_rad);
+    const Vec2 r = rotate(m, s, -1.0);
     uv = {r.x / m.view_size_mm.x + 0.5, 0.5 - r.y / m.view_size_mm.y};
   } else {
     const auto c = owner_lens_centre(m, s);

@@ -19,6 +19,7 @@ struct EyeMapping {
   Vec2 pixel_pitch_mm;
   Vec2 shift_px;            // calibration shift: the image moves right/down by this much
   double rotation_rad = 0;  // lens lattice rotation (lens_array + calibration); for stock devices the image's
+  double rotation_cos = 1, rotation_sin = 0;
   bool has_lens_array = false;
 
   // Lens array devices.

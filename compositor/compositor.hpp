@@ -1,0 +1,29 @@
+#pragma once
+// The compositor stage: a stereo pair of views in, one image per eye at panel resolution out
+// (DESIGN.md §3–4). Implementations: the OpenGL path (gl_compositor) and the CPU reference.
+#include <array>
+
+#include "compositor/image.hpp"
+#include "compositor/profile.hpp"
+
+namespace nelf {
+
+struct CompositorOptions {
+  // 0: one bilinear tap (comparison only); 1: footprint prefilter (default);
+  // 4, 16: prefilter plus N aperture sub-samples per pixel.
+  int fsaa = 1;
+};
+
+// Throws std::invalid_argument naming the allowed values when `fsaa` is not 0, 1, 4 or 16.
+void validate_fsaa(int fsaa);
+
+using EyeImages = std::array<Image, 2>;  // indexed by Eye
+
+class Compositor {
+ public:
+  virtual ~Compositor() = default;
+  // Renders both eyes' images for `views`. Each view's display_aspect sets the screen's aspect.
+  virtual EyeImages compose(const StereoPair& views) = 0;
+};
+
+}  // namespace nelf
