@@ -2,6 +2,7 @@
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 #include <unistd.h>
 #include <algorithm>
@@ -333,6 +334,13 @@ void write_trade_space_plot(const Profile& profile, const std::filesystem::path&
   if (fs::is_directory(path, ec))
     throw PlotError(fmt::format("cannot write plot {}: it is a directory", path.string()));
 
+  // Ask for a writer before drawing, so that an unknown extension is reported by its own name.
+  if (!OIIO::ImageOutput::create(path.string())) {
+    OIIO::geterror();  // clear OpenImageIO's pending message: ours replaces it
+    throw PlotError(fmt::format("cannot write plot {}: no image format for extension '{}' (use .png)", path.string(),
+                                path.extension().string()));
+  }
+
   const OIIO::ImageBuf image = draw_plot(profile);
 
   // Hidden temporary name with the same extension, so that OpenImageIO picks the same format.
@@ -340,6 +348,7 @@ void write_trade_space_plot(const Profile& profile, const std::filesystem::path&
       directory / fmt::format(".{}.tmp-{}{}", path.stem().string(), ::getpid(), path.extension().string());
   if (!image.write(temporary.string(), OIIO::TypeDesc::UINT8)) {
     std::string why = image.geterror();
+    if (why.empty()) why = OIIO::geterror();  // format lookups report through the global error
     fs::remove(temporary, ec);
     if (why.empty()) why = "OpenImageIO could not write it";
     // OpenImageIO's messages can span lines; the user gets one.
