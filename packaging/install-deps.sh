@@ -16,6 +16,8 @@ packages=(
   libglm-dev libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libsdl2-dev
   # tests
   libgtest-dev libgmock-dev
+  # fonts for the text of `nelf design --plot` (OpenImageIO render_text)
+  fonts-dejavu-core
 )
 
 missing=()

@@ -1,0 +1,366 @@
+#include "compositor/design_plot.hpp"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
+#include <unistd.h>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "compositor/optics.hpp"
+
+namespace nelf {
+
+int trade_space_resolution_px(const Profile& profile, double focal_mm, double lens_pitch_mm) {
+  optics::AxisGeometry g;
+  g.display_mm = profile.display.width_mm();
+  g.pixel_pitch_mm = profile.display.pixel_pitch_mm.x;
+  g.lens_pitch_mm = lens_pitch_mm;
+  g.focal_mm = focal_mm;
+  g.eye_relief_mm = profile.viewing.eye_relief_mm;
+  g.image_mm = profile.viewing.virtual_image_mm;
+  return optics::resolution_px(g);
+}
+
+namespace {
+
+using Rgb = std::array<float, 3>;
+
+constexpr Rgb kWhite = {1.f, 1.f, 1.f};
+constexpr Rgb kBlack = {0.f, 0.f, 0.f};
+constexpr Rgb kDarkGrey = {0.25f, 0.25f, 0.25f};
+
+// Perceptually uniform, colour-blind safe, readable in greyscale: matplotlib's viridis, sampled at
+// 0, 0.1, …, 1 (sRGB) and interpolated linearly.
+Rgb viridis(double t) {
+  static constexpr std::array<Rgb, 11> stops = {{{0.267f, 0.005f, 0.329f},
+                                                 {0.282f, 0.141f, 0.459f},
+                                                 {0.255f, 0.267f, 0.529f},
+                                                 {0.208f, 0.373f, 0.553f},
+                                                 {0.165f, 0.471f, 0.557f},
+                                                 {0.129f, 0.569f, 0.549f},
+                                                 {0.133f, 0.659f, 0.518f},
+                                                 {0.267f, 0.749f, 0.439f},
+                                                 {0.478f, 0.820f, 0.318f},
+                                                 {0.741f, 0.875f, 0.149f},
+                                                 {0.993f, 0.906f, 0.144f}}};
+  const double x = std::clamp(t, 0.0, 1.0) * 10.0;
+  const auto i = std::min<std::size_t>(static_cast<std::size_t>(x), 9);
+  const float w = static_cast<float>(x - static_cast<double>(i));
+  Rgb c;
+  for (std::size_t k = 0; k < 3; ++k) c[k] = stops[i][k] * (1.f - w) + stops[i + 1][k] * w;
+  return c;
+}
+
+// A "nice" step (1, 2 or 5 × 10^k) giving roughly `count` intervals over `range`.
+double nice_step(double range, int count) {
+  const double raw = range / count;
+  const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
+  const double fraction = raw / magnitude;
+  const double nice = fraction <= 1.0 ? 1.0 : fraction <= 2.0 ? 2.0 : fraction <= 5.0 ? 5.0 : 10.0;
+  return nice * magnitude;
+}
+
+std::string tick_label(double value, double step) {
+  // As many decimals as the step needs, no more: 0.5 → "0.5", 1 → "1", 0.25 → "0.25".
+  const int decimals = step >= 1.0 ? 0 : static_cast<int>(std::ceil(-std::log10(step) - 1e-9));
+  return fmt::format("{:.{}f}", value, std::max(decimals, 0));
+}
+
+// An RGB raster in floating point; the picture is drawn here and handed to OpenImageIO for the text
+// and the file.
+class Canvas {
+ public:
+  Canvas(int width, int height) : width_(width), height_(height), pixels_(std::size_t(width) * height * 3, 1.f) {}
+  int width() const { return width_; }
+  int height() const { return height_; }
+  bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < width_ && y < height_; }
+  void set(int x, int y, Rgb c) {
+    if (inside(x, y)) std::copy(c.begin(), c.end(), pixels_.begin() + std::ptrdiff_t(offset(x, y)));
+  }
+  // Mixes `c` over the pixel with opacity `alpha`.
+  void blend(int x, int y, Rgb c, float alpha) {
+    if (!inside(x, y)) return;
+    float* p = &pixels_[offset(x, y)];
+    for (std::size_t k = 0; k < 3; ++k) p[k] = p[k] * (1.f - alpha) + c[k] * alpha;
+  }
+  void fill_rect(int x0, int y0, int x1, int y1, Rgb c) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) set(x, y, c);
+  }
+  // A line `thickness` pixels wide (square brush), sampled densely enough to leave no gaps.
+  void line(double x0, double y0, double x1, double y1, Rgb c, int thickness = 1) {
+    const int steps = static_cast<int>(std::ceil(std::max(std::abs(x1 - x0), std::abs(y1 - y0)))) + 1;
+    const int lo = -(thickness - 1) / 2, hi = thickness / 2;
+    for (int s = 0; s <= steps; ++s) {
+      const double t = static_cast<double>(s) / steps;
+      const int x = static_cast<int>(std::lround(x0 + (x1 - x0) * t));
+      const int y = static_cast<int>(std::lround(y0 + (y1 - y0) * t));
+      for (int dy = lo; dy <= hi; ++dy)
+        for (int dx = lo; dx <= hi; ++dx) set(x + dx, y + dy, c);
+    }
+  }
+  void rect_outline(int x0, int y0, int x1, int y1, Rgb c, int thickness) {
+    line(x0, y0, x1, y0, c, thickness);
+    line(x1, y0, x1, y1, c, thickness);
+    line(x1, y1, x0, y1, c, thickness);
+    line(x0, y1, x0, y0, c, thickness);
+  }
+  void ring(double cx, double cy, double radius, Rgb c, double width) {
+    for (int y = int(cy - radius - width); y <= int(cy + radius + width) + 1; ++y)
+      for (int x = int(cx - radius - width); x <= int(cx + radius + width) + 1; ++x)
+        if (std::abs(std::hypot(x - cx, y - cy) - radius) <= width / 2) set(x, y, c);
+  }
+  OIIO::ImageBuf to_image() const {
+    OIIO::ImageBuf buf(OIIO::ImageSpec(width_, height_, 3, OIIO::TypeDesc::FLOAT));
+    buf.set_pixels(OIIO::ROI(0, width_, 0, height_, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT, pixels_.data());
+    return buf;
+  }
+
+ private:
+  std::size_t offset(int x, int y) const { return (std::size_t(y) * std::size_t(width_) + std::size_t(x)) * 3; }
+  int width_, height_;
+  std::vector<float> pixels_;
+};
+
+// A font OpenImageIO can render with (Debian: fonts-dejavu-core); the plain name lets OpenImageIO
+// search its own font paths elsewhere. The labels stay ASCII: OpenImageIO 2.4's render_text draws
+// a non-ASCII character such as µ as a wrong glyph.
+std::string plot_font() {
+  for (const char* candidate : {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+                                "/usr/share/fonts/TTF/DejaVuSans.ttf", "/usr/share/fonts/dejavu/DejaVuSans.ttf"}) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(candidate, ec)) return candidate;
+  }
+  return "DejaVuSans";
+}
+
+// Text on the finished raster. Every call checks for failure: a missing font must be an error that
+// says what to install, not a picture without labels.
+class TextPainter {
+ public:
+  TextPainter(OIIO::ImageBuf& image, std::string font) : image_(image), font_(std::move(font)) {}
+  void draw(int x, int y, const std::string& text, int size, Rgb colour = kBlack,
+            OIIO::ImageBufAlgo::TextAlignX align_x = OIIO::ImageBufAlgo::TextAlignX::Left,
+            OIIO::ImageBufAlgo::TextAlignY align_y = OIIO::ImageBufAlgo::TextAlignY::Baseline, int shadow = 0) {
+    if (!OIIO::ImageBufAlgo::render_text(image_, x, y, text, size, font_, colour, align_x, align_y, shadow))
+      fail(image_.geterror());
+  }
+  // Text running upwards (the y-axis label), centred on (cx, cy).
+  void draw_vertical(int cx, int cy, const std::string& text, int size) {
+    const OIIO::ROI box = OIIO::ImageBufAlgo::text_size(text, size, font_);
+    if (!box.defined()) fail("cannot measure text");
+    const int w = box.width() + 8, h = box.height() + 8;
+    OIIO::ImageBuf label(OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::FLOAT));
+    OIIO::ImageBufAlgo::fill(label, kWhite);
+    if (!OIIO::ImageBufAlgo::render_text(label, 4 - box.xbegin, 4 - box.ybegin, text, size, font_, kBlack))
+      fail(label.geterror());
+    const OIIO::ImageBuf rotated = OIIO::ImageBufAlgo::rotate270(label);
+    if (!OIIO::ImageBufAlgo::paste(image_, cx - h / 2, cy - w / 2, 0, 0, rotated)) fail(image_.geterror());
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& why) const {
+    throw PlotError(fmt::format("cannot draw the plot's text with font '{}' (install fonts-dejavu-core): {}", font_,
+                                why.empty() ? "unknown OpenImageIO error" : why));
+  }
+  OIIO::ImageBuf& image_;
+  std::string font_;
+};
+
+struct Axis {
+  double lo, hi;
+  int pixel_lo, pixel_hi;  // pixel of lo and of hi (hi may be the smaller pixel: the y axis grows up)
+  double to_pixel(double v) const { return pixel_lo + (v - lo) / (hi - lo) * (pixel_hi - pixel_lo); }
+  double from_pixel(double p) const { return lo + (p - pixel_lo) / (pixel_hi - pixel_lo) * (hi - lo); }
+};
+
+OIIO::ImageBuf draw_plot(const Profile& profile) {
+  constexpr int width = 1100, height = 820;
+  constexpr int left = 110, right = 900, top = 96, bottom = 720;  // the plot area
+  constexpr int bar_left = 940, bar_right = 970;                  // the colour bar
+
+  // The ranges of Fig. 5, widened when this profile's lens array lies outside them.
+  const bool mark = profile.lens_array.has_value();
+  double f_hi = 10.0, w_hi = 5.0;
+  if (mark) {
+    f_hi = std::max(f_hi, std::ceil(profile.lens_array->focal_length_mm * 1.2));
+    w_hi = std::max(w_hi, std::ceil(profile.lens_array->pitch_mm * 1.2));
+  }
+  const Axis fx{1.0, f_hi, left, right};
+  const Axis wy{0.25, w_hi, bottom, top};
+
+  // N_p at every pixel centre of the plot area.
+  const int plot_w = right - left, plot_h = bottom - top;
+  std::vector<int> resolution(std::size_t(plot_w) * plot_h);
+  int max_resolution = 1;
+  for (int y = 0; y < plot_h; ++y)
+    for (int x = 0; x < plot_w; ++x) {
+      const double f = fx.from_pixel(left + x + 0.5), w = wy.from_pixel(top + y + 0.5);
+      const int n = trade_space_resolution_px(profile, f, w);
+      resolution[std::size_t(y) * plot_w + x] = n;
+      max_resolution = std::max(max_resolution, n);
+    }
+  const double bar_step = nice_step(max_resolution, 6);
+  const double bar_max = std::ceil(max_resolution / bar_step) * bar_step;
+
+  Canvas canvas(width, height);
+  for (int y = 0; y < plot_h; ++y)
+    for (int x = 0; x < plot_w; ++x) {
+      const int n = resolution[std::size_t(y) * plot_w + x];
+      canvas.set(left + x, top + y, viridis(n / bar_max));
+    }
+
+  // f/w_l < 1 (lenses faster than f/1, impractical to make as a microlens sheet): greyed and hatched.
+  for (int y = top; y < bottom; ++y)
+    for (int x = left; x < right; ++x) {
+      const double f = fx.from_pixel(x + 0.5), w = wy.from_pixel(y + 0.5);
+      if (f / w >= 1.0) continue;
+      canvas.blend(x, y, {0.55f, 0.55f, 0.55f}, 0.55f);
+      if ((x - y + 4096) % 14 < 2) canvas.blend(x, y, kDarkGrey, 0.7f);
+    }
+  // Its border, f = w_l.
+  const double diagonal_end = std::min(fx.hi, wy.hi);
+  canvas.line(fx.to_pixel(std::max(fx.lo, wy.lo)), wy.to_pixel(std::max(fx.lo, wy.lo)), fx.to_pixel(diagonal_end),
+              wy.to_pixel(diagonal_end), kDarkGrey, 2);
+
+  // Frame and ticks.
+  canvas.rect_outline(left - 1, top - 1, right, bottom, kBlack, 2);
+  const double f_step = nice_step(fx.hi - fx.lo, 9);
+  const double w_step = nice_step(wy.hi - wy.lo, 9);
+  std::vector<std::pair<int, std::string>> x_ticks, y_ticks;
+  for (double f = std::ceil(fx.lo / f_step) * f_step; f <= fx.hi + 1e-9; f += f_step) {
+    const int px = static_cast<int>(std::lround(fx.to_pixel(f)));
+    canvas.line(px, bottom, px, bottom + 7, kBlack, 2);
+    x_ticks.emplace_back(px, tick_label(f, f_step));
+  }
+  for (double w = std::ceil(wy.lo / w_step) * w_step; w <= wy.hi + 1e-9; w += w_step) {
+    const int py = static_cast<int>(std::lround(wy.to_pixel(w)));
+    canvas.line(left - 8, py, left - 1, py, kBlack, 2);
+    y_ticks.emplace_back(py, tick_label(w, w_step));
+  }
+
+  // Colour bar, 0 at the bottom.
+  for (int y = top; y < bottom; ++y) {
+    const double value = (bottom - y - 0.5) / plot_h * bar_max;
+    canvas.fill_rect(bar_left, y, bar_right, y + 1, viridis(value / bar_max));
+  }
+  canvas.rect_outline(bar_left - 1, top - 1, bar_right, bottom, kBlack, 1);
+  std::vector<std::pair<int, std::string>> bar_ticks;
+  for (double v = 0.0; v <= bar_max + 1e-9; v += bar_step) {
+    const int py = static_cast<int>(std::lround(bottom - v / bar_max * plot_h));
+    canvas.line(bar_right, py, bar_right + 6, py, kBlack, 2);
+    bar_ticks.emplace_back(py, tick_label(v, bar_step));
+  }
+
+  // The profile's design: a white ring with a cross, outlined in black so it shows on any colour.
+  double mark_x = 0, mark_y = 0;
+  if (mark) {
+    mark_x = fx.to_pixel(profile.lens_array->focal_length_mm);
+    mark_y = wy.to_pixel(profile.lens_array->pitch_mm);
+    canvas.ring(mark_x, mark_y, 10, kBlack, 5);
+    canvas.ring(mark_x, mark_y, 10, kWhite, 2.5);
+    canvas.line(mark_x - 16, mark_y, mark_x + 16, mark_y, kBlack, 4);
+    canvas.line(mark_x, mark_y - 16, mark_x, mark_y + 16, kBlack, 4);
+    canvas.line(mark_x - 15, mark_y, mark_x + 15, mark_y, kWhite, 2);
+    canvas.line(mark_x, mark_y - 15, mark_x, mark_y + 15, kWhite, 2);
+  }
+
+  OIIO::ImageBuf image = canvas.to_image();
+  using OIIO::ImageBufAlgo::TextAlignX;
+  using OIIO::ImageBufAlgo::TextAlignY;
+  TextPainter text(image, plot_font());
+  const std::string name = profile.name.empty() ? std::string("profile") : profile.name;
+  text.draw(left, 40, fmt::format("Spatial resolution N_p (Eq. 8, horizontal) over the lens design space: {}", name),
+            22);
+  text.draw(left, 72,
+            fmt::format("display {:.4g} mm ({} px at {:.4g} mm), eye relief d_e {:.4g} mm, virtual image d_o {:.6g} "
+                        "mm, gap d_l from Eq. 1",
+                        profile.display.width_mm(), profile.display.resolution[0], profile.display.pixel_pitch_mm.x,
+                        profile.viewing.eye_relief_mm, profile.viewing.virtual_image_mm),
+            15, {0.2f, 0.2f, 0.2f});
+  for (const auto& [px, label] : x_ticks)
+    text.draw(px, bottom + 12, label, 16, kBlack, TextAlignX::Center, TextAlignY::Top);
+  for (const auto& [py, label] : y_ticks)
+    text.draw(left - 13, py, label, 16, kBlack, TextAlignX::Right, TextAlignY::Center);
+  for (const auto& [py, label] : bar_ticks)
+    text.draw(bar_right + 10, py, label, 16, kBlack, TextAlignX::Left, TextAlignY::Center);
+  text.draw((left + right) / 2, bottom + 58, "lens focal length f (mm)", 20, kBlack, TextAlignX::Center,
+            TextAlignY::Baseline);
+  text.draw_vertical(left - 72, (top + bottom) / 2, "lens pitch w_l (mm)", 20);
+  text.draw_vertical(bar_right + 70, (top + bottom) / 2, "spatial resolution N_p (px)", 18);
+
+  // Label the hatched region inside it, near the top-left corner where it is widest.
+  text.draw(left + 14, top + 30, "f/w_l < 1: faster than f/1", 17, kWhite, TextAlignX::Left, TextAlignY::Baseline, 2);
+  text.draw(left + 14, top + 52, "(impractical lenses)", 15, kWhite, TextAlignX::Left, TextAlignY::Baseline, 2);
+
+  const int legend_y = height - 22;
+  if (mark) {
+    const int n = trade_space_resolution_px(profile, profile.lens_array->focal_length_mm, profile.lens_array->pitch_mm);
+    const std::string label = fmt::format("{}: f {:.4g} mm, w_l {:.4g} mm, N_p {} px", name,
+                                          profile.lens_array->focal_length_mm, profile.lens_array->pitch_mm, n);
+    // Right of the mark unless that would leave the plot area.
+    const auto box = OIIO::ImageBufAlgo::text_size(label, 17, plot_font());
+    const bool flip = mark_x + 22 + box.width() > right;
+    text.draw(static_cast<int>(mark_x) + (flip ? -22 : 22), static_cast<int>(mark_y) - 14, label, 17, kWhite,
+              flip ? TextAlignX::Right : TextAlignX::Left, TextAlignY::Bottom, 2);
+    text.draw(left, legend_y,
+              "Marked: this profile's lens array. Hatched: f-number below 1. Bands: steps in the number of "
+              "lenses used N_l (Eq. 6).",
+              14, {0.2f, 0.2f, 0.2f});
+  } else {
+    text.draw(
+        left, legend_y,
+        fmt::format("{} has no lens array: nothing marked. Hatched: f-number below 1. Bands: steps in N_l (Eq. 6).",
+                    name),
+        14, {0.2f, 0.2f, 0.2f});
+  }
+  return image;
+}
+
+}  // namespace
+
+void write_trade_space_plot(const Profile& profile, const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  const fs::path directory = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(directory, ec))
+    throw PlotError(
+        fmt::format("cannot write plot {}: directory {} does not exist", path.string(), directory.string()));
+  if (fs::is_directory(path, ec))
+    throw PlotError(fmt::format("cannot write plot {}: it is a directory", path.string()));
+
+  // Ask for a writer before drawing, so that an unknown extension is reported by its own name.
+  if (!OIIO::ImageOutput::create(path.string())) {
+    OIIO::geterror();  // clear OpenImageIO's pending message: ours replaces it
+    throw PlotError(fmt::format("cannot write plot {}: no image format for extension '{}' (use .png)", path.string(),
+                                path.extension().string()));
+  }
+
+  const OIIO::ImageBuf image = draw_plot(profile);
+
+  // Hidden temporary name with the same extension, so that OpenImageIO picks the same format.
+  const fs::path temporary =
+      directory / fmt::format(".{}.tmp-{}{}", path.stem().string(), ::getpid(), path.extension().string());
+  if (!image.write(temporary.string(), OIIO::TypeDesc::UINT8)) {
+    std::string why = image.geterror();
+    if (why.empty()) why = OIIO::geterror();  // format lookups report through the global error
+    fs::remove(temporary, ec);
+    if (why.empty()) why = "OpenImageIO could not write it";
+    // OpenImageIO's messages can span lines; the user gets one.
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    throw PlotError(fmt::format("cannot write plot {}: {}", path.string(), why));
+  }
+  fs::rename(temporary, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+    throw PlotError(fmt::format("cannot write plot {}: {}", path.string(), ec.message()));
+  }
+}
+
+}  // namespace nelf
