@@ -2,11 +2,15 @@
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <memory>
 #include <system_error>
@@ -67,6 +71,37 @@ Image read_opened(OIIO::ImageInput& input, const std::string& name) {
     src += channels;
   }
   return image;
+}
+
+// OIIO 2.4's PNG reader leaves libpng's default error handler in place, which prints
+// "libpng error: ..." on stderr before OIIO turns the failure into an error we report ourselves.
+// While a PNG is decoded, fd 2 points at /dev/null so that the user sees our one line only. Only
+// PNGs, and only for the call's duration: nothing else prints meanwhile in the still path.
+class SilencedStderr {
+ public:
+  SilencedStderr() {
+    std::fflush(stderr);
+    saved_ = ::dup(STDERR_FILENO);
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
+    if (null >= 0) ::close(null);
+  }
+  ~SilencedStderr() {
+    if (saved_ < 0) return;
+    ::dup2(saved_, STDERR_FILENO);
+    ::close(saved_);
+  }
+  SilencedStderr(const SilencedStderr&) = delete;
+  SilencedStderr& operator=(const SilencedStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
+bool has_png_signature(const fs::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  char magic[8] = {};
+  return file.read(magic, sizeof magic) && std::memcmp(magic, "\x89PNG\r\n\x1a\n", 8) == 0;
 }
 
 std::vector<std::byte> read_bytes(const fs::path& path) {
@@ -191,8 +226,12 @@ Image decode_image(std::span<const std::byte> encoded, const std::string& format
   OIIO::Filesystem::IOMemReader reader(encoded.data(), encoded.size());
   auto input = OIIO::ImageInput::create(format, false, nullptr, &reader);
   if (!input) throw StillError(fmt::format("{}: no {} reader ({})", name, format, first_line(OIIO::geterror())));
+  // The reader reads from the proxy handed over in the open configuration, not from a file.
+  OIIO::ImageSpec config;
+  OIIO::Filesystem::IOProxy* proxy = &reader;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
   OIIO::ImageSpec spec;
-  if (!input->open(name, spec))
+  if (!input->open(name, spec, config))
     throw StillError(fmt::format("{}: cannot read the image: {}", name, first_line(input->geterror())));
   Image image = read_opened(*input, name);
   input->close();
@@ -202,6 +241,8 @@ Image decode_image(std::span<const std::byte> encoded, const std::string& format
 Image read_image_file(const fs::path& path) {
   require_file(path);
   const std::string name = path.string();
+  std::optional<SilencedStderr> silence_libpng;
+  if (has_png_signature(path)) silence_libpng.emplace();
   std::unique_ptr<OIIO::ImageInput> input;
   if (lowercase_extension(path) == ".jps") {
     // OIIO does not know the .jps extension; a JPS file is a JPEG.
