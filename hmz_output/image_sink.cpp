@@ -6,9 +6,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
-#include <cctype>
 #include <cstring>
 #include <optional>
 #include <string>
@@ -132,6 +132,11 @@ void write_image_file(const Image& image, const fs::path& path, const ImageWrite
   check_image_writable(path, options);
   if (image.empty()) throw ImageWriteError(fmt::format("cannot write {}: empty image", path.string()));
   const FileFormat format = *format_for(path);
+  // libjpeg's limit; OIIO 2.4 lets libjpeg's error handler exit the process beyond it.
+  constexpr int kMaxJpegDimension = 65500;
+  if (format == FileFormat::jpeg && (image.width() > kMaxJpegDimension || image.height() > kMaxJpegDimension))
+    throw ImageWriteError(fmt::format("cannot write {}: {}x{} exceeds JPEG's limit of {} pixels per side",
+                                      path.string(), image.width(), image.height(), kMaxJpegDimension));
 
   TemporaryFile temp(path);
   OIIO::TypeDesc pixel_type = options.bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8;
