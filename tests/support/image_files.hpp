@@ -36,6 +36,7 @@ inline Image filled_image(int w, int h, Rgba colour) {
 // Reads an image file back as float RGBA (test side, independent of nelf's reader).
 struct ReadBack {
   int width = 0, height = 0, channels = 0;
+  int bits = 0;  // per channel, as stored in the file
   std::vector<float> pixels;
   float at(int x, int y, int c) const {
     return pixels[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) *
@@ -46,7 +47,8 @@ struct ReadBack {
 inline ReadBack read_back(const std::filesystem::path& path) {
   auto in = OIIO::ImageInput::open(path.string());
   if (!in) throw std::runtime_error("cannot read back " + path.string() + ": " + OIIO::geterror());
-  ReadBack r{in->spec().width, in->spec().height, in->spec().nchannels, {}};
+  ReadBack r{
+      in->spec().width, in->spec().height, in->spec().nchannels, static_cast<int>(in->spec().format.size() * 8), {}};
   r.pixels.resize(static_cast<std::size_t>(r.width) * static_cast<std::size_t>(r.height) *
                   static_cast<std::size_t>(r.channels));
   if (!in->read_image(0, 0, 0, r.channels, OIIO::TypeDesc::FLOAT, r.pixels.data()))
