@@ -173,6 +173,67 @@ TEST(ConvertStills, MonoFallbackWarns) {
   EXPECT_GT(stats(out, 160, 0, 320, 90).red, 3 * stats(out, 160, 0, 320, 90).blue);  // both eyes see the one view
 }
 
+// Every still format routes the left view to the left eye: the sbs output's left half is reddish.
+TEST(ConvertStills, EveryStillFormatRoutesTheEyes) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  const Image l = view_image(320, 180, true), r = view_image(320, 180, false);
+  write_test_image(dir / "l.png", l, 3);
+  write_test_image(dir / "r.png", r, 3);
+  write_test_image(dir / "rl.png", sbs_image(320, 180), 3);  // left-right; --swap-eyes makes it right-left
+  Image tab(320, 360), fp(1280, 1470), jps(640, 180);
+  for (int y = 0; y < 180; ++y)
+    for (int x = 0; x < 320; ++x) {
+      tab.at(x, y) = l.at(x, y);
+      tab.at(x, 180 + y) = r.at(x, y);
+      jps.at(x, y) = r.at(x, y);  // JPS: right view first
+      jps.at(320 + x, y) = l.at(x, y);
+    }
+  for (int y = 0; y < 720; ++y)
+    for (int x = 0; x < 1280; ++x) {
+      fp.at(x, y) = l.at(x % 320, y % 180);
+      fp.at(x, 750 + y) = r.at(x % 320, y % 180);
+    }
+  write_test_image(dir / "movie.Half-OU.png", tab, 3);
+  write_test_image(dir / "packed.png", fp, 3);
+  write_test_image(dir / "photo.jps", jps, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  write_test_image(dir / "l.jpg", l, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  write_test_image(dir / "r.jpg", r, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  test::write_file(dir / "camera.mpo", test::read_file(dir / "l.jpg") + test::read_file(dir / "r.jpg"));
+
+  const std::string inputs[] = {
+      q(dir / "l.png") + " --right " + q(dir / "r.png"),
+      q(dir / "movie.Half-OU.png"),
+      q(dir / "packed.png"),
+      q(dir / "photo.jps"),
+      q(dir / "camera.mpo"),
+      q(dir / "r.png") + " --right " + q(dir / "l.png") + " --swap-eyes",
+  };
+  int n = 0;
+  for (const auto& input : inputs) {
+    SCOPED_TRACE(input);
+    const auto out = dir / ("out" + std::to_string(n++) + ".png");
+    const auto result = run_nelf("convert " + input + " " + q(out) + " --signal sbs --profile " + q(profile));
+    ASSERT_EQ(result.status, 0) << result.err;
+    EXPECT_EQ(result.err, "");
+    const auto img = read_back(out);
+    ASSERT_EQ(img.width, 320);
+    const AreaStats left = stats(img, 0, 0, 160, 90), right = stats(img, 160, 0, 320, 90);
+    EXPECT_GT(left.red, 3 * left.blue);
+    EXPECT_GT(right.blue, 3 * right.red);
+  }
+  // A left-right frame with --swap-eyes puts the right (bluish) half in the left eye.
+  const auto swapped = dir / "swapped.png";
+  ASSERT_EQ(run_nelf("convert " + q(dir / "rl.png") + " " + q(swapped) +
+                     " --layout sbs --swap-eyes --signal sbs "
+                     "--profile " +
+                     q(profile))
+                .status,
+            0);
+  const auto img = read_back(swapped);
+  EXPECT_GT(stats(img, 0, 0, 160, 90).blue, 3 * stats(img, 0, 0, 160, 90).red);
+}
+
 // Runs a failing conversion and checks the contract: status, exactly one line on stderr that
 // contains `expected`, and the directory exactly as it was (no output, no temporary file).
 void expect_clean_failure(const TempDir& dir, const std::string& args, int status, const std::string& expected) {
