@@ -3,6 +3,8 @@
 #include <OpenImageIO/imageio.h>
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <pthread.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -103,6 +105,30 @@ class TemporaryFile {
   fs::path path_;
 };
 
+// Holds back SIGINT, SIGTERM and SIGHUP of the calling thread while the file is written and renamed,
+// so that Ctrl-C cannot leave a temporary file behind; a pending signal is delivered when the block
+// ends, after the file is complete (or removed). Lasts a fraction of a second for a frame.
+class DeferredTermination {
+ public:
+  DeferredTermination() {
+    sigset_t block;
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigaddset(&block, SIGTERM);
+    sigaddset(&block, SIGHUP);
+    active_ = ::pthread_sigmask(SIG_BLOCK, &block, &previous_) == 0;
+  }
+  ~DeferredTermination() {
+    if (active_) ::pthread_sigmask(SIG_SETMASK, &previous_, nullptr);
+  }
+  DeferredTermination(const DeferredTermination&) = delete;
+  DeferredTermination& operator=(const DeferredTermination&) = delete;
+
+ private:
+  sigset_t previous_{};
+  bool active_ = false;
+};
+
 }  // namespace
 
 void check_image_writable(const fs::path& path, const ImageWriteOptions& options) {
@@ -138,6 +164,7 @@ void write_image_file(const Image& image, const fs::path& path, const ImageWrite
     throw ImageWriteError(fmt::format("cannot write {}: {}x{} exceeds JPEG's limit of {} pixels per side",
                                       path.string(), image.width(), image.height(), kMaxJpegDimension));
 
+  const DeferredTermination no_interruptions;  // declared first: ends after the temporary file is gone
   TemporaryFile temp(path);
   OIIO::TypeDesc pixel_type = options.bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8;
   if (format == FileFormat::exr) pixel_type = OIIO::TypeDesc::HALF;

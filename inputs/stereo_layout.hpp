@@ -72,7 +72,9 @@ struct LayoutDecision {
   std::string warning;  // non-empty when the result is a guess the user should know about
 };
 
-// Detection order: explicit flag -> metadata -> exact HDMI frame-packed frame size -> filename
+// Detection order: explicit flag -> metadata (half or full from the frame's aspect, with the
+// thresholds of the aspect rule: side-by-side is full when W/H >= 3, top-bottom when W/H <= 1)
+// -> exact HDMI frame-packed frame size -> filename
 // tokens -> aspect (W/H >= 3 full SBS, W/H <= 1 full TAB) -> mono with a warning.
 // `.jps` files store right-left side-by-side by convention: they are sbs when nothing else says
 // otherwise, and their views are swapped whatever rule decided the layout.
