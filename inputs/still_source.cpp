@@ -151,7 +151,7 @@ StillStereo load_mpo(const fs::path& path, const StillOptions& options) {
                     "leave --layout out)",
                     path.string(), to_string(*options.layout)));
   const auto bytes = read_bytes(path);
-  const auto starts = find_jpeg_images(bytes);
+  const auto starts = find_mpo_images(bytes);
   if (starts.size() < 2)
     throw StillError(
         fmt::format("{}: the MPO file holds {} image(s), a stereo pair needs two", path.string(), starts.size()));
@@ -208,6 +208,71 @@ std::optional<std::size_t> end_of_jpeg(std::span<const std::byte> bytes, std::si
   return std::nullopt;
 }
 
+// Reads big- or little-endian integers of a TIFF structure inside `bytes`, failing on any read
+// outside it.
+class TiffReader {
+ public:
+  TiffReader(std::span<const std::byte> bytes, bool little_endian) : bytes_(bytes), little_(little_endian) {}
+  std::optional<std::uint32_t> read(std::size_t at, int size) const {
+    if (at > bytes_.size() || static_cast<std::size_t>(size) > bytes_.size() - at) return std::nullopt;
+    std::uint32_t value = 0;
+    for (int i = 0; i < size; ++i) {
+      const std::uint32_t b = byte_at(bytes_, at + static_cast<std::size_t>(little_ ? size - 1 - i : i));
+      value = (value << 8) | b;
+    }
+    return value;
+  }
+
+ private:
+  std::span<const std::byte> bytes_;
+  bool little_;
+};
+
+// The image offsets of the MP Index IFD (CIPA DC-007, APP2 "MPF\0" in the first image), or nothing
+// when the first image has no valid index. Offsets in the index count from the TIFF header inside the
+// APP2 segment; the first image's entry is 0 and means the start of the file.
+std::optional<std::vector<std::size_t>> mpf_image_offsets(std::span<const std::byte> bytes) {
+  const std::size_t n = bytes.size();
+  if (n < 4 || byte_at(bytes, 0) != 0xFF || byte_at(bytes, 1) != 0xD8) return std::nullopt;
+  std::size_t p = 2;
+  while (p + 4 <= n && byte_at(bytes, p) == 0xFF) {
+    const std::uint8_t marker = byte_at(bytes, p + 1);
+    if (marker == 0xDA || marker == 0xD9) break;  // the index lives in the header segments
+    const std::size_t length = (std::size_t{byte_at(bytes, p + 2)} << 8) | byte_at(bytes, p + 3);
+    if (length < 2 || p + 2 + length > n) return std::nullopt;
+    const std::size_t payload = p + 4, payload_end = p + 2 + length;
+    if (marker == 0xE2 && payload + 8 <= payload_end && std::memcmp(&bytes[payload], "MPF", 4) == 0) {
+      const std::size_t base = payload + 4;
+      const auto tiff = bytes.subspan(base, payload_end - base);
+      const bool little = byte_at(tiff, 0) == 'I' && byte_at(tiff, 1) == 'I';
+      if (!little && !(byte_at(tiff, 0) == 'M' && byte_at(tiff, 1) == 'M')) return std::nullopt;
+      const TiffReader r(tiff, little);
+      const auto ifd = r.read(4, 4);
+      const auto count = ifd ? r.read(*ifd, 2) : std::nullopt;
+      if (!count) return std::nullopt;
+      for (std::uint32_t i = 0; i < *count; ++i) {
+        const std::size_t entry = *ifd + 2 + 12 * std::size_t{i};
+        const auto tag = r.read(entry, 2), size = r.read(entry + 4, 4), where = r.read(entry + 8, 4);
+        if (!tag || !size || !where) return std::nullopt;
+        if (*tag != 0xB002) continue;  // MP Entry: 16 bytes per image
+        std::vector<std::size_t> offsets;
+        for (std::uint32_t e = 0; e + 16 <= *size; e += 16) {
+          const auto offset = r.read(std::size_t{*where} + e + 8, 4);
+          if (!offset) return std::nullopt;
+          const std::size_t start = *offset == 0 ? 0 : base + *offset;
+          if (start + 2 > n || byte_at(bytes, start) != 0xFF || byte_at(bytes, start + 1) != 0xD8) return std::nullopt;
+          offsets.push_back(start);
+        }
+        if (!std::is_sorted(offsets.begin(), offsets.end())) return std::nullopt;
+        return offsets;
+      }
+      return std::nullopt;
+    }
+    p = payload_end;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::vector<std::size_t> find_jpeg_images(std::span<const std::byte> bytes) {
@@ -219,6 +284,12 @@ std::vector<std::size_t> find_jpeg_images(std::span<const std::byte> bytes) {
     if (!end) break;  // truncated or broken: whatever follows is not a separate image we can trust
     from = *end;
   }
+  return starts;
+}
+
+std::vector<std::size_t> find_mpo_images(std::span<const std::byte> bytes) {
+  auto starts = mpf_image_offsets(bytes).value_or(std::vector<std::size_t>{});
+  if (starts.size() < 2) starts = find_jpeg_images(bytes);
   return starts;
 }
 

@@ -8,6 +8,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "compositor/image.hpp"
 #include "inputs/stereo_layout.hpp"
@@ -35,6 +36,10 @@ Image decode_image(std::span<const std::byte> encoded, const std::string& format
 // Byte offsets of the JPEG images stored back to back in `bytes` (an MPO file holds two or more;
 // a plain JPEG one). Walks the JPEG segments of each image to its EOI, then looks for the next SOI.
 std::vector<std::size_t> find_jpeg_images(std::span<const std::byte> bytes);
+
+// Offsets of the images of an MPO file: from its MP Index IFD (APP2 "MPF" of the first image) when
+// that is present and points at JPEG images, else from find_jpeg_images.
+std::vector<std::size_t> find_mpo_images(std::span<const std::byte> bytes);
 
 struct StillOptions {
   std::optional<StereoLayout> layout;          // --layout; nothing = detect

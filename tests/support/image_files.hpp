@@ -88,4 +88,28 @@ inline std::string with_embedded_thumbnail(const std::string& jpeg, const std::s
   return jpeg.substr(0, 2) + segment + payload + jpeg.substr(2);
 }
 
+inline std::string le16(std::uint32_t v) { return {static_cast<char>(v), static_cast<char>(v >> 8)}; }
+inline std::string le32(std::uint32_t v) { return le16(v & 0xFFFF) + le16(v >> 16); }
+
+// A minimal MPO in the CIPA DC-007 layout: the left JPEG with an APP2 "MPF" segment (little-endian
+// MP Index IFD: version and two MP entries) right after its SOI, then `gap` bytes, then the right JPEG.
+inline std::string mpo_with_index(const std::string& left, const std::string& gap, const std::string& right) {
+  constexpr std::uint32_t kIfd = 8, kEntries = kIfd + 2 + 2 * 12 + 4;  // MP entries follow the IFD
+  constexpr std::size_t kTiffSize = kEntries + 2 * 16;
+  constexpr std::size_t kSegmentSize = 2 + 2 + 4 + kTiffSize;
+  constexpr std::size_t kBase = 2 + 2 + 2 + 4;  // SOI, APP2 marker, length, "MPF\0": the TIFF header
+  const std::size_t left_size = left.size() + kSegmentSize;
+  const std::uint32_t right_offset = static_cast<std::uint32_t>(left_size + gap.size() - kBase);
+  std::string tiff = "II*" + std::string(1, '\0') + le32(kIfd) + le16(2);
+  tiff += le16(0xB000) + le16(7) + le32(4) + "0100";                                           // MP format version
+  tiff += le16(0xB002) + le16(7) + le32(32) + le32(kEntries);                                  // MP entries
+  tiff += le32(0);                                                                             // no next IFD
+  tiff += le32(0x20030000) + le32(static_cast<std::uint32_t>(left_size)) + le32(0) + le32(0);  // base image
+  tiff += le32(0x00020002) + le32(static_cast<std::uint32_t>(right.size())) + le32(right_offset) + le32(0);
+  const std::size_t length = kSegmentSize - 2;
+  const std::string segment = std::string("\xFF\xE2", 2) + static_cast<char>(length >> 8) +
+                              static_cast<char>(length & 0xFF) + std::string("MPF\0", 4) + tiff;
+  return left.substr(0, 2) + segment + left.substr(2) + gap + right;
+}
+
 }  // namespace nelf::test

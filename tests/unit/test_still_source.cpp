@@ -246,6 +246,31 @@ TEST(StillSource, MpoWithEmbeddedThumbnail) {
   EXPECT_TRUE(bluish(s.views.right.image.at(0, 0)));
 }
 
+TEST(StillSource, MpoIndexBeatsScanning) {
+  TempDir dir;
+  const std::string left = jpeg_bytes(dir, filled_image(48, 32, kReddish), "l.jpg");
+  const std::string right = jpeg_bytes(dir, filled_image(48, 32, kBluish), "r.jpg");
+  // Bytes between the images that look like an SOI: a scanner takes them for the second image.
+  const std::string decoy = std::string("\xFF\xD8\xFF\xE0", 4) + std::string(60, '\x11');
+  const std::string mpo = test::mpo_with_index(left, decoy, right);
+  const auto bytes = std::as_bytes(std::span(mpo.data(), mpo.size()));
+  const std::size_t right_start = mpo.size() - right.size();
+  ASSERT_EQ(find_jpeg_images(bytes).size(), 2u);
+  EXPECT_NE(find_jpeg_images(bytes)[1], right_start);  // fooled by the decoy
+  EXPECT_EQ(find_mpo_images(bytes), (std::vector<std::size_t>{0, right_start}));
+  test::write_file(dir / "indexed.mpo", mpo);
+  const StillStereo s = load_still(dir / "indexed.mpo", {});
+  EXPECT_TRUE(reddish(s.views.left.image.at(0, 0)));
+  EXPECT_TRUE(bluish(s.views.right.image.at(47, 31)));
+
+  // An index pointing at something that is not a JPEG is ignored in favour of scanning.
+  std::string broken = test::mpo_with_index(left, "", right);
+  const auto broken_bytes = std::as_bytes(std::span(broken.data(), broken.size()));
+  EXPECT_EQ(find_mpo_images(broken_bytes)[1], broken.size() - right.size());
+  broken[broken.size() - right.size() + 1] = 'x';  // destroy the right image's SOI
+  EXPECT_EQ(find_mpo_images(broken_bytes), find_jpeg_images(broken_bytes));
+}
+
 TEST(StillSource, BadMpo) {
   TempDir dir;
   const std::string left = jpeg_bytes(dir, filled_image(48, 32, kReddish), "l.jpg");
