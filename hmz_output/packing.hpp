@@ -1,0 +1,22 @@
+#pragma once
+// Packs the compositor's two eye images into the frame of an output signal.
+#include <stdexcept>
+
+#include "compositor/compositor.hpp"
+#include "hmz_output/signal.hpp"
+
+namespace nelf {
+
+// Both eye images must have the same, non-zero size. HDMI frame packing: left eye in rows
+// [0, eye_height), black gap (RGB 0, alpha 1), right eye from row eye_height + gap_rows. When the eye
+// images are not the signal's eye size (a 1280x720 panel on hdmi-fp-1080p24), each is centred 1:1 in
+// its eye area with black borders, cropped symmetrically when larger: scaling would resample the
+// elemental images, whose pixels must land exactly on the panel's pixels behind each lenslet.
+// sbs: left | right; tab: left over right; left/right: that eye alone.
+// Throws std::invalid_argument for empty or mismatched eye images.
+Image pack_eyes(const Signal& signal, const Image& left, const Image& right);
+inline Image pack_eyes(const Signal& signal, const EyeImages& eyes) {
+  return pack_eyes(signal, eyes[static_cast<int>(Eye::left)], eyes[static_cast<int>(Eye::right)]);
+}
+
+}  // namespace nelf

@@ -1,0 +1,238 @@
+#include "inputs/stereo_layout.hpp"
+
+#include <fmt/format.h>
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstring>
+#include <utility>
+
+namespace nelf {
+namespace {
+
+struct LayoutName {
+  StereoLayout layout;
+  std::string_view name;
+};
+constexpr std::array<LayoutName, 8> kLayoutNames{{
+    {StereoLayout::sbs, "sbs"},
+    {StereoLayout::sbs_half, "sbs-half"},
+    {StereoLayout::tab, "tab"},
+    {StereoLayout::tab_half, "tab-half"},
+    {StereoLayout::fp, "fp"},
+    {StereoLayout::alt, "alt"},
+    {StereoLayout::pair, "pair"},
+    {StereoLayout::mono, "mono"},
+}};
+
+// The two HDMI 1.4a frame-packed formats (DESIGN.md §7): the gap is the vertical blanking of one eye.
+constexpr std::array<FramePackedGeometry, 2> kFramePacked{{{1280, 720, 30}, {1920, 1080, 45}}};
+
+// Copies the w x h block at (x0, y0) of `frame`.
+Image crop(const Image& frame, int x0, int y0, int w, int h) {
+  Image out(w, h);
+  for (int y = 0; y < h; ++y) {
+    const Rgba* src = &frame.at(x0, y0 + y);
+    std::copy(src, src + w, &out.at(0, y));
+  }
+  return out;
+}
+
+double ratio(int w, int h) { return static_cast<double>(w) / static_cast<double>(h); }
+
+std::string frame_size(const Image& frame) { return fmt::format("{}x{}", frame.width(), frame.height()); }
+
+// Side-by-side half or full, told apart by the frame's aspect as the aspect rule does: a full SBS
+// frame is at least 3:1 (two 16:9 views are 3.56:1), a full TAB frame at most 1:1.
+bool full_side_by_side(int w, int h) { return h > 0 && ratio(w, h) >= 3.0; }
+bool full_top_bottom(int w, int h) { return h > 0 && ratio(w, h) <= 1.0; }
+
+std::string lowercase(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+std::vector<std::string> alphanumeric_tokens(std::string_view text) {
+  std::vector<std::string> tokens;
+  std::string current;
+  for (char c : text) {
+    if (std::isalnum(static_cast<unsigned char>(c))) {
+      current += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    } else if (!current.empty()) {
+      tokens.push_back(std::move(current));
+      current.clear();
+    }
+  }
+  if (!current.empty()) tokens.push_back(std::move(current));
+  return tokens;
+}
+
+bool is_jps(const std::filesystem::path& filename) { return lowercase(filename.extension().string()) == ".jps"; }
+
+}  // namespace
+
+std::string_view to_string(StereoLayout layout) {
+  for (const auto& entry : kLayoutNames)
+    if (entry.layout == layout) return entry.name;
+  return "unknown";
+}
+
+std::optional<StereoLayout> parse_stereo_layout(std::string_view name) {
+  for (const auto& entry : kLayoutNames)
+    if (entry.name == name) return entry.layout;
+  return std::nullopt;
+}
+
+const std::vector<std::string_view>& stereo_layout_names() {
+  static const std::vector<std::string_view> names = [] {
+    std::vector<std::string_view> v;
+    for (const auto& entry : kLayoutNames) v.push_back(entry.name);
+    return v;
+  }();
+  return names;
+}
+
+std::optional<FramePackedGeometry> frame_packed_geometry(int width, int height) {
+  for (const auto& g : kFramePacked)
+    if (g.width == width && g.height() == height) return g;
+  return std::nullopt;
+}
+
+StereoPair split_frame(const Image& frame, StereoLayout layout, bool swap_eyes) {
+  if (frame.width() <= 0 || frame.height() <= 0)
+    throw LayoutError(fmt::format("layout {} does not fit an empty {} frame", to_string(layout), frame_size(frame)));
+  const int w = frame.width(), h = frame.height();
+  StereoPair pair;
+  switch (layout) {
+    case StereoLayout::sbs:
+    case StereoLayout::sbs_half: {
+      if (w % 2 != 0)
+        throw LayoutError(fmt::format("layout {} does not fit a {} frame: side-by-side needs an even width",
+                                      to_string(layout), frame_size(frame)));
+      // A full view keeps its own pixel aspect; a half view was squeezed to half width.
+      const double aspect = layout == StereoLayout::sbs ? ratio(w / 2, h) : ratio(w, h);
+      pair.left = View{crop(frame, 0, 0, w / 2, h), aspect};
+      pair.right = View{crop(frame, w / 2, 0, w / 2, h), aspect};
+      break;
+    }
+    case StereoLayout::tab:
+    case StereoLayout::tab_half: {
+      if (h % 2 != 0)
+        throw LayoutError(fmt::format("layout {} does not fit a {} frame: top-bottom needs an even height",
+                                      to_string(layout), frame_size(frame)));
+      const double aspect = layout == StereoLayout::tab ? ratio(w, h / 2) : ratio(w, h);
+      pair.left = View{crop(frame, 0, 0, w, h / 2), aspect};
+      pair.right = View{crop(frame, 0, h / 2, w, h / 2), aspect};
+      break;
+    }
+    case StereoLayout::fp: {
+      const auto g = frame_packed_geometry(w, h);
+      if (!g)
+        throw LayoutError(
+            fmt::format("layout fp does not fit a {} frame: HDMI frame packing is 1280x1470 (30-line gap) or 1920x2205 "
+                        "(45-line gap)",
+                        frame_size(frame)));
+      const double aspect = ratio(g->width, g->eye_height);
+      pair.left = View{crop(frame, 0, 0, w, g->eye_height), aspect};
+      pair.right = View{crop(frame, 0, g->eye_height + g->gap_rows, w, g->eye_height), aspect};
+      break;
+    }
+    case StereoLayout::mono:
+      pair.left = View{frame, ratio(w, h)};
+      pair.right = View{frame, ratio(w, h)};
+      break;
+    case StereoLayout::alt:
+      throw LayoutError("layout alt (frame-sequential) needs a video: one frame holds only one view");
+    case StereoLayout::pair:
+      throw LayoutError("layout pair needs two images (the right view with --right)");
+  }
+  if (swap_eyes) std::swap(pair.left, pair.right);
+  return pair;
+}
+
+std::string_view to_string(DetectionRule rule) {
+  switch (rule) {
+    case DetectionRule::flag:
+      return "flag";
+    case DetectionRule::metadata:
+      return "metadata";
+    case DetectionRule::frame_size:
+      return "frame-size";
+    case DetectionRule::filename:
+      return "filename";
+    case DetectionRule::aspect:
+      return "aspect";
+    case DetectionRule::fallback:
+      return "default";
+  }
+  return "unknown";
+}
+
+std::optional<FilenameLayout> layout_from_filename(const std::filesystem::path& filename) {
+  const auto tokens = alphanumeric_tokens(filename.filename().string());
+  bool says_3d = false;
+  for (std::size_t i = 0; i < tokens.size(); ++i) {
+    const std::string& t = tokens[i];
+    const std::string next = i + 1 < tokens.size() ? tokens[i + 1] : std::string();
+    // Two-token spellings first: "half-sbs", "h.sbs", "half_ou", "full-sbs", "full.tab".
+    if (t == "h" || t == "half") {
+      if (next == "sbs") return FilenameLayout{StereoLayout::sbs_half};
+      if (next == "tab" || next == "ou") return FilenameLayout{StereoLayout::tab_half};
+    }
+    if (t == "sbs" || t == "fsbs") return FilenameLayout{StereoLayout::sbs};
+    if (t == "hsbs") return FilenameLayout{StereoLayout::sbs_half};
+    if (t == "tab" || t == "ou" || t == "ftab" || t == "fou") return FilenameLayout{StereoLayout::tab};
+    if (t == "htab" || t == "hou") return FilenameLayout{StereoLayout::tab_half};
+    if (t == "lr") return FilenameLayout{StereoLayout::sbs};
+    if (t == "rl") return FilenameLayout{StereoLayout::sbs, true};
+    if (t == "3d") says_3d = true;
+  }
+  // "3D" with nothing more specific: release groups mean half side-by-side by it.
+  if (says_3d) return FilenameLayout{StereoLayout::sbs_half};
+  return std::nullopt;
+}
+
+LayoutDecision detect_stereo_layout(const LayoutEvidence& evidence) {
+  LayoutDecision decision = [&]() -> LayoutDecision {
+    if (evidence.flag) return {*evidence.flag, false, DetectionRule::flag, {}};
+    if (evidence.metadata) {
+      const auto& m = *evidence.metadata;
+      const int w = evidence.width, h = evidence.height;
+      switch (m.arrangement) {
+        case StereoMetadata::Arrangement::side_by_side:
+          return {full_side_by_side(w, h) ? StereoLayout::sbs : StereoLayout::sbs_half,
+                  m.inverted,
+                  DetectionRule::metadata,
+                  {}};
+        case StereoMetadata::Arrangement::top_bottom:
+          return {full_top_bottom(w, h) ? StereoLayout::tab : StereoLayout::tab_half,
+                  m.inverted,
+                  DetectionRule::metadata,
+                  {}};
+        case StereoMetadata::Arrangement::frame_sequential:
+          return {StereoLayout::alt, m.inverted, DetectionRule::metadata, {}};
+        case StereoMetadata::Arrangement::mono:
+          return {StereoLayout::mono, false, DetectionRule::metadata, {}};
+      }
+    }
+    if (frame_packed_geometry(evidence.width, evidence.height))
+      return {StereoLayout::fp, false, DetectionRule::frame_size, {}};
+    if (auto named = layout_from_filename(evidence.filename))
+      return {named->layout, named->swap_eyes, DetectionRule::filename, {}};
+    if (is_jps(evidence.filename)) return {StereoLayout::sbs, false, DetectionRule::filename, {}};
+    if (evidence.height > 0 && full_side_by_side(evidence.width, evidence.height))
+      return {StereoLayout::sbs, false, DetectionRule::aspect, {}};
+    if (evidence.height > 0 && full_top_bottom(evidence.width, evidence.height))
+      return {StereoLayout::tab, false, DetectionRule::aspect, {}};
+    return {StereoLayout::mono, false, DetectionRule::fallback,
+            fmt::format("no stereo layout detected for {} ({}x{}); showing it as 2D to both eyes (pass --layout "
+                        "to choose one)",
+                        evidence.filename.filename().string(), evidence.width, evidence.height)};
+  }();
+  // JPS stores the right view on the left by definition of the format, whatever decided the layout.
+  if (is_jps(evidence.filename)) decision.swap_eyes = !decision.swap_eyes;
+  return decision;
+}
+
+}  // namespace nelf

@@ -1,0 +1,92 @@
+#pragma once
+// Stereo input layouts (DESIGN.md §6): their names, how a full frame splits into two views, and the
+// detection order that picks a layout when the user gives none. Pure functions, no I/O; video reuses
+// them with its container metadata as extra evidence.
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "compositor/image.hpp"
+
+namespace nelf {
+
+enum class StereoLayout { sbs, sbs_half, tab, tab_half, fp, alt, pair, mono };
+
+// A layout that cannot be applied: it does not fit the frame, or needs more than one frame.
+// what() is one line saying what does not fit and why.
+class LayoutError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// "sbs", "sbs-half", "tab", "tab-half", "fp", "alt", "pair", "mono".
+std::string_view to_string(StereoLayout layout);
+std::optional<StereoLayout> parse_stereo_layout(std::string_view name);
+const std::vector<std::string_view>& stereo_layout_names();
+
+// The frame sizes of the HDMI 1.4a frame-packed formats accepted as `fp` input.
+struct FramePackedGeometry {
+  int width;
+  int eye_height;
+  int gap_rows;
+  int height() const { return 2 * eye_height + gap_rows; }
+};
+std::optional<FramePackedGeometry> frame_packed_geometry(int width, int height);
+
+// Splits one full frame into its two views. Side-by-side and top-bottom halves keep the frame's
+// pixels; half layouts are anamorphic, so each view is displayed at the full frame's aspect
+// (1920x1080 sbs-half -> two 960x1080 views shown at 16:9). `mono` gives the same view to both eyes.
+// `swap_eyes` exchanges the two views (right-left sources). Throws LayoutError when the layout does
+// not fit (odd width for side-by-side, odd height for top-bottom, fp of a size that is not a
+// frame-packed format, an empty frame) or needs two frames (`alt`, `pair`).
+StereoPair split_frame(const Image& frame, StereoLayout layout, bool swap_eyes = false);
+
+// Stereo metadata carried by a container or stream (AVStereo3D and friends). It says how the views
+// are arranged but never whether they are half or full resolution; that is inferred from the aspect.
+struct StereoMetadata {
+  enum class Arrangement { mono, side_by_side, top_bottom, frame_sequential };
+  Arrangement arrangement = Arrangement::mono;
+  bool inverted = false;  // right view first (AV_STEREO3D_FLAG_INVERT)
+};
+
+// Which rule of the detection order decided (`nelf probe` prints it).
+enum class DetectionRule { flag, metadata, frame_size, filename, aspect, fallback };
+// "flag", "metadata", "frame-size", "filename", "aspect", "default".
+std::string_view to_string(DetectionRule rule);
+
+struct LayoutEvidence {
+  std::optional<StereoLayout> flag;        // the user's --layout
+  std::optional<StereoMetadata> metadata;  // from the container or stream, when there is any
+  int width = 0;                           // the full frame's size
+  int height = 0;
+  std::filesystem::path filename;  // only the last component is looked at
+};
+
+struct LayoutDecision {
+  StereoLayout layout = StereoLayout::mono;
+  bool swap_eyes = false;  // the source stores the right view first
+  DetectionRule rule = DetectionRule::fallback;
+  std::string warning;  // non-empty when the result is a guess the user should know about
+};
+
+// Detection order: explicit flag -> metadata (half or full from the frame's aspect, with the
+// thresholds of the aspect rule: side-by-side is full when W/H >= 3, top-bottom when W/H <= 1)
+// -> exact HDMI frame-packed frame size -> filename
+// tokens -> aspect (W/H >= 3 full SBS, W/H <= 1 full TAB) -> mono with a warning.
+// `.jps` files store right-left side-by-side by convention: they are sbs when nothing else says
+// otherwise, and their views are swapped whatever rule decided the layout.
+LayoutDecision detect_stereo_layout(const LayoutEvidence& evidence);
+
+// The filename rule alone: release-name tokens (any case, delimited by non-alphanumerics), e.g.
+// "Movie.2010.3D.HSBS.1080p.mkv" -> sbs-half, "photo_rl.jpg" -> sbs swapped, "clip.3D.mp4" ->
+// sbs-half. Returns nothing when no token names a layout.
+struct FilenameLayout {
+  StereoLayout layout;
+  bool swap_eyes = false;
+};
+std::optional<FilenameLayout> layout_from_filename(const std::filesystem::path& filename);
+
+}  // namespace nelf
