@@ -198,8 +198,8 @@ EyeImages GlCompositor::compose(const StereoPair& views) {
   return eyes;
 }
 
-gl::Texture upload_texture(const Image& image) {
-  gl::Texture texture = gl::make_texture_2d(GL_RGBA32F, image.width(), image.height());
+gl::Texture upload_texture(const Image& image, GLenum internal_format) {
+  gl::Texture texture = gl::make_texture_2d(internal_format, image.width(), image.height());
   update_texture(texture, image);
   return texture;
 }

@@ -107,8 +107,9 @@ class GlCompositor final : public Compositor {
   std::array<EyeTarget, 2> eye_targets_;               // per eye, for compose()
 };
 
-// A texture holding `image` (GL_RGBA32F: the float data goes up unconverted).
-gl::Texture upload_texture(const Image& image);
+// A texture holding `image` in `internal_format` (GL_RGBA16F keeps 10-bit sources' precision;
+// GL_RGBA8 is what 8-bit video decodes to; GL_RGBA32F is exact but samples slowly on llvmpipe).
+gl::Texture upload_texture(const Image& image, GLenum internal_format = GL_RGBA16F);
 // Replaces the contents of a texture of the same size.
 void update_texture(const gl::Texture& texture, const Image& image);
 
