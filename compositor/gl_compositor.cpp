@@ -56,6 +56,10 @@ PrefilterPlan plan_prefilter(const EyeMapping& mapping, int width, int height, i
     const double box_squared =
         footprint * footprint + 2.0 - plan.block[axis] * plan.block[axis] - 2.0 * spacing * spacing;
     plan.box[axis] = std::sqrt(std::max(box_squared, 1.0));
+    // The screen is black around the view: extend the grid until the box lies wholly outside, so
+    // the outermost samples are black and the clamped texture stays black beyond them.
+    plan.margin[axis] = static_cast<int>(std::ceil((0.5 * plan.box[axis] + plan.block[axis]) / spacing)) + 1;
+    plan.output[axis] += 2 * plan.margin[axis];
   }
   return plan;
 }
@@ -69,9 +73,10 @@ GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shar
   empty_vertex_array_ = gl::make_vertex_array();
   sampler_ = gl::make_linear_clamp_sampler();
   elemental_program_ = gl::make_program("fullscreen.vert", "elemental.frag");
+  border_program_ = gl::make_program("border_strips.vert", "elemental.frag", "#define NELF_AREA_SAMPLE 1\n");
   reduce_program_ = gl::make_program("fullscreen.vert", "prefilter_reduce.frag");
   box_program_ = gl::make_program("fullscreen.vert", "prefilter_box.frag");
-  for (GLuint program : {elemental_program_.id(), reduce_program_.id(), box_program_.id()})
+  for (GLuint program : {elemental_program_.id(), border_program_.id(), reduce_program_.id(), box_program_.id()})
     set_uniform_int(program, program == box_program_.id() ? "u_input" : "u_view", 0);
   gl::check_error("creating the compositor's programs");
 }
@@ -84,7 +89,8 @@ GlCompositor::~GlCompositor() {
   }
 }
 
-GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, PrefilterTargets& t) {
+GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, int view_width, int view_height,
+                               PrefilterTargets& t) {
   const auto ensure = [](std::array<int, 2>& size, std::array<int, 2> wanted, gl::Texture& texture,
                          gl::Framebuffer& fbo) {
     if (size == wanted && texture) return;
@@ -111,7 +117,10 @@ GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, P
     input = t.reduced_texture.id();
   }
   glUseProgram(box_program_.id());
+  const int view_size[2] = {view_width, view_height};
   const auto box_pass = [&](int axis, GLuint fbo, std::array<int, 2> size, double cell) {
+    set_uniform(box_program_.id(), "u_out_origin", f(-plan.margin[axis] * plan.spacing[axis]));
+    set_uniform(box_program_.id(), "u_view_extent", f(view_size[axis]));
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, size[0], size[1]);
     set_uniform_int(box_program_.id(), "u_axis", axis);
@@ -135,40 +144,58 @@ void GlCompositor::render_eye(Eye eye, const GlTextureView& view, const GlTarget
   const int subsamples = subsamples_per_axis(options_.fsaa);
 
   GLuint source = view.texture;
+  float scale[2] = {1.f, 1.f}, offset[2] = {0.f, 0.f};
+  bool cut_outside = true;
   if (options_.fsaa != 0) {
     const PrefilterPlan plan = plan_prefilter(m, view.width, view.height, subsamples);
-    if (plan.enabled) source = prefilter(plan, view.texture, prefilter_targets_[static_cast<int>(eye)]);
+    if (plan.enabled) {
+      source = prefilter(plan, view.texture, view.width, view.height, prefilter_targets_[static_cast<int>(eye)]);
+      for (int axis = 0; axis < 2; ++axis) {
+        // uv ∈ [0, 1] covers the samples between the margins.
+        scale[axis] = f(static_cast<double>(plan.output[axis] - 2 * plan.margin[axis]) / plan.output[axis]);
+        offset[axis] = f(static_cast<double>(plan.margin[axis]) / plan.output[axis]);
+      }
+      cut_outside = false;
+    }
   }
 
-  const GLuint p = elemental_program_.id();
-  set_uniform(p, "u_region_origin", f(target.x), f(target.y));
-  set_uniform(p, "u_panel", f(m.panel[0]), f(m.panel[1]));
-  set_uniform(p, "u_pixel_pitch", f(m.pixel_pitch_mm.x), f(m.pixel_pitch_mm.y));
-  set_uniform(p, "u_shift", f(m.shift_px.x), f(m.shift_px.y));
-  set_uniform(p, "u_rotation", f(m.rotation_cos), f(m.rotation_sin));
-  set_uniform_int(p, "u_has_lens_array", m.has_lens_array ? 1 : 0);
-  set_uniform_int(p, "u_subsamples", subsamples);
-  set_uniform_int(p, "u_area_sample", options_.fsaa == 1 ? 1 : 0);
-  if (m.has_lens_array) {
-    set_uniform(p, "u_to_lens_plane", f(m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm)));
-    set_uniform(p, "u_lattice_offset", f(m.lattice_offset_mm.x), f(m.lattice_offset_mm.y));
-    set_uniform(p, "u_lens_pitch", f(m.lens_pitch_mm));
-    set_uniform_int(p, "u_first_lens", m.first_lens[0], m.first_lens[1]);
-    set_uniform_int(p, "u_lenses", m.lenses[0], m.lenses[1]);
-    set_uniform(p, "u_chief_ray_scale", f((m.render_distance_mm - m.eye_relief_mm) / m.gap_mm));
-    set_uniform(p, "u_screen_centre", f(m.screen_centre_mm.x), f(m.screen_centre_mm.y));
-    set_uniform(p, "u_screen_size", f(m.screen_size_mm.x), f(m.screen_size_mm.y));
-  } else {
-    set_uniform(p, "u_view_size", f(m.view_size_mm.x), f(m.view_size_mm.y));
+  // Pass 1 (every pixel): point samples. Pass 2 (fsaa >= 1, lens arrays): strips along the
+  // elemental-image borders redo the pixels there with the per-lens area split.
+  for (const GLuint p : {elemental_program_.id(), border_program_.id()}) {
+    set_uniform(p, "u_texture_scale", scale[0], scale[1]);
+    set_uniform(p, "u_texture_offset", offset[0], offset[1]);
+    set_uniform_int(p, "u_cut_outside", cut_outside ? 1 : 0);
+    set_uniform(p, "u_region_origin", f(target.x), f(target.y));
+    set_uniform(p, "u_panel", f(m.panel[0]), f(m.panel[1]));
+    set_uniform(p, "u_pixel_pitch", f(m.pixel_pitch_mm.x), f(m.pixel_pitch_mm.y));
+    set_uniform(p, "u_shift", f(m.shift_px.x), f(m.shift_px.y));
+    set_uniform(p, "u_rotation", f(m.rotation_cos), f(m.rotation_sin));
+    set_uniform_int(p, "u_has_lens_array", m.has_lens_array ? 1 : 0);
+    set_uniform_int(p, "u_subsamples", subsamples);
+    if (m.has_lens_array) {
+      set_uniform(p, "u_to_lens_plane", f(m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm)));
+      set_uniform(p, "u_lattice_offset", f(m.lattice_offset_mm.x), f(m.lattice_offset_mm.y));
+      set_uniform(p, "u_lens_pitch", f(m.lens_pitch_mm));
+      set_uniform_int(p, "u_first_lens", m.first_lens[0], m.first_lens[1]);
+      set_uniform_int(p, "u_lenses", m.lenses[0], m.lenses[1]);
+      set_uniform(p, "u_chief_ray_scale", f((m.render_distance_mm - m.eye_relief_mm) / m.gap_mm));
+      set_uniform(p, "u_screen_centre", f(m.screen_centre_mm.x), f(m.screen_centre_mm.y));
+      set_uniform(p, "u_screen_size", f(m.screen_size_mm.x), f(m.screen_size_mm.y));
+    } else {
+      set_uniform(p, "u_view_size", f(m.view_size_mm.x), f(m.view_size_mm.y));
+    }
   }
-
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   glViewport(target.x, target.y, m.panel[0], m.panel[1]);
   glBindVertexArray(empty_vertex_array_.id());
   glBindSampler(0, sampler_.id());
   glBindTextureUnit(0, source);
-  glUseProgram(p);
+  glUseProgram(elemental_program_.id());
   glDrawArrays(GL_TRIANGLES, 0, 3);
+  if (options_.fsaa != 0 && m.has_lens_array) {
+    glUseProgram(border_program_.id());
+    glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
+  }
   gl::check_error("rendering an eye image");
 }
 

@@ -49,7 +49,8 @@ struct PrefilterPlan {
   std::array<double, 2> footprint{};  // F: the (sub-)sample footprint in view texels
   std::array<int, 2> block{1, 1};     // R: view texels averaged per cell by the block-mean pass
   std::array<int, 2> reduced{0, 0};   // size of the block-mean texture
-  std::array<int, 2> output{0, 0};    // size of the prefiltered texture
+  std::array<int, 2> margin{0, 0};    // prefiltered samples beyond each edge of the view (black there)
+  std::array<int, 2> output{0, 0};    // size of the prefiltered texture, margins included
   std::array<double, 2> spacing{};    // g: view texels between prefiltered samples
   std::array<double, 2> box{};        // B: box width (view texels) of the separable pass
 };
@@ -94,14 +95,15 @@ class GlCompositor final : public Compositor {
   };
 
   // Runs the prefilter passes; returns the texture the elemental pass samples.
-  GLuint prefilter(const PrefilterPlan& plan, GLuint view_texture, PrefilterTargets& targets);
+  GLuint prefilter(const PrefilterPlan& plan, GLuint view_texture, int view_width, int view_height,
+                   PrefilterTargets& targets);
 
   std::shared_ptr<gl::EglContext> context_;
   Profile profile_;
   CompositorOptions options_;
   gl::VertexArray empty_vertex_array_;
   gl::Sampler sampler_;
-  gl::Program elemental_program_, reduce_program_, box_program_;
+  gl::Program elemental_program_, border_program_, reduce_program_, box_program_;
   std::array<PrefilterTargets, 2> prefilter_targets_;  // per eye
   std::array<UploadedView, 2> uploads_;                // per eye, for compose()
   std::array<EyeTarget, 2> eye_targets_;               // per eye, for compose()

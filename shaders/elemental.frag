@@ -3,10 +3,17 @@
 // compositor/mapping.cpp (view_coordinate) in float. Pixel positions are taken relative to the
 // panel's pixel grid, so float keeps sub-micrometre precision.
 //
+// Compiled twice: as is for pass 1 (point samples over the whole region), and with
+// NELF_AREA_SAMPLE defined for the border strips (a compile-time switch: llvmpipe would otherwise
+// evaluate both sides of a run-time choice for every pixel).
+//
 // Memory layout: row 0 of the target region is the top row of the eye image (as in nelf::Image);
 // the view textures likewise hold the image's top row first, so t (down) is the texture's y.
 
 uniform sampler2D u_view;      // the view, or its footprint-prefiltered version
+uniform vec2 u_texture_scale;  // u_view coordinate = uv * scale + offset: the prefiltered
+uniform vec2 u_texture_offset; // texture extends beyond the screen (black margin)
+uniform bool u_cut_outside;    // sampling the view itself: black outside the screen
 uniform vec2 u_region_origin;  // lower-left corner of the eye's region in the target (pixels)
 uniform vec2 u_panel;          // panel resolution
 uniform vec2 u_pixel_pitch;    // mm
@@ -23,7 +30,6 @@ uniform vec2 u_screen_centre;     // mm
 uniform vec2 u_screen_size;       // mm
 uniform vec2 u_view_size;         // mm, stock devices
 uniform int u_subsamples;         // per axis: 1, 2 or 4
-uniform bool u_area_sample;       // fsaa 1: one tap per lens the pixel overlaps
 
 out vec4 colour;
 
@@ -39,6 +45,13 @@ vec2 display_position(vec2 pixel) {
 
 bool inside(vec2 uv) { return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))); }
 
+// The view at screen coordinate uv. The prefiltered texture already fades to black across the
+// screen's edge over the footprint; the raw view is cut there.
+vec3 tap(vec2 uv) {
+  if (u_cut_outside && !inside(uv)) return vec3(0.0);
+  return textureLod(u_view, uv * u_texture_scale + u_texture_offset, 0.0).rgb;
+}
+
 // The view at display position s as seen through lens (m, n): black outside the lit block or the screen.
 vec3 through_lens(vec2 s, ivec2 lens) {
   if (any(lessThan(lens, u_first_lens)) || any(greaterThanEqual(lens, u_first_lens + u_lenses))) return vec3(0.0);
@@ -46,7 +59,7 @@ vec3 through_lens(vec2 s, ivec2 lens) {
   const vec2 v = c + (s - c) * u_chief_ray_scale;  // chief ray back to the screen plane
   const vec2 uv =
       vec2((v.x - u_screen_centre.x) / u_screen_size.x + 0.5, 0.5 - (v.y - u_screen_centre.y) / u_screen_size.y);
-  return inside(uv) ? textureLod(u_view, uv, 0.0).rgb : vec3(0.0);
+  return tap(uv);
 }
 
 // Position in the lens lattice (units of the lens pitch, rotated frame) of display position s.
@@ -58,20 +71,20 @@ vec3 point_sample(vec2 pixel) {
   if (!u_has_lens_array) {
     const vec2 r = rotate(s, -1.0);
     const vec2 uv = vec2(r.x / u_view_size.x + 0.5, 0.5 - r.y / u_view_size.y);
-    return inside(uv) ? textureLod(u_view, uv, 0.0).rgb : vec3(0.0);
+    return tap(uv);
   }
   return through_lens(s, ivec2(floor(lattice_position(s) + 0.5)));
 }
 
-// One tap per lens that the pixel's aperture overlaps (fsaa 1): a pixel straddling an elemental
-// image border mixes both sides by area, as the reference's sub-samples do; each part is tapped at
-// its centroid. Interior pixels (almost all) take a single tap. Exact for an unrotated lattice;
+// One tap per lens that an `aperture`×`aperture` pixel square centred on `pixel` overlaps: a
+// (sub-)pixel straddling an elemental image border mixes both sides by area, as the reference's
+// sub-samples do; each part is tapped at its centroid. Interior ones (almost all) take one tap. Exact for an unrotated lattice;
 // for a rotated one the aperture is approximated by an axis-aligned square in lattice coordinates.
-vec3 area_sample(vec2 pixel) {
+vec3 area_sample(vec2 pixel, float aperture) {
   if (!u_has_lens_array) return point_sample(pixel);
   const vec2 s = display_position(pixel);
   const vec2 q = lattice_position(s);
-  const vec2 half_pixel = 0.5 * u_pixel_pitch * u_to_lens_plane / u_lens_pitch;
+  const vec2 half_pixel = 0.5 * aperture * u_pixel_pitch * u_to_lens_plane / u_lens_pitch;
   const vec2 own = floor(q + 0.5);
   const vec2 lo = q - half_pixel, hi = q + half_pixel;
   // Per axis: which neighbour (±1, or 0 for none) the aperture reaches into, and the split point.
@@ -104,15 +117,20 @@ vec3 area_sample(vec2 pixel) {
 }
 
 void main() {
+  // Stratified sub-samples (1, 2×2 or 4×4). Pass 1 point-samples each; the border-strip pass
+  // (border_strips.vert) area-samples each sub-aperture, splitting it between the lenses it overlaps.
   const vec2 pixel_corner = floor(gl_FragCoord.xy - u_region_origin);
-  if (u_area_sample) {
-    colour = vec4(area_sample(pixel_corner + 0.5), 1.0);
-    return;
-  }
-  vec3 sum = vec3(0.0);
   const float step_ = 1.0 / float(u_subsamples);
-  for (int sy = 0; sy < u_subsamples; ++sy)
-    for (int sx = 0; sx < u_subsamples; ++sx)  // stratified; each uses the lens owning its position
-      sum += point_sample(pixel_corner + (vec2(sx, sy) + 0.5) * step_);
+  vec3 sum = vec3(0.0);
+  for (int sy = 0; sy < u_subsamples; ++sy) {
+    for (int sx = 0; sx < u_subsamples; ++sx) {
+      const vec2 centre = pixel_corner + (vec2(sx, sy) + 0.5) * step_;
+#ifdef NELF_AREA_SAMPLE
+      sum += area_sample(centre, step_);
+#else
+      sum += point_sample(centre);
+#endif
+    }
+  }
   colour = vec4(sum * (step_ * step_), 1.0);
 }

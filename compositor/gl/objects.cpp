@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <string>
 
 #include "compositor/embedded.hpp"
@@ -11,13 +12,17 @@ namespace nelf::gl {
 
 namespace {
 
-Shader compile(GLenum stage, std::string_view name) {
+Shader compile(GLenum stage, std::string_view name, std::string_view defines) {
   const auto source = embedded::find(embedded::nelf_embedded_shaders(), name);
   if (!source) throw GlError(fmt::format("shader {} is not embedded in this build", name));
+  // #version must stay the first line: the defines go right after it.
+  const std::size_t first_line_end = std::min(source->find('\n'), source->size());
+  const std::string text = std::string(source->substr(0, first_line_end)) + "\n" + std::string(defines) +
+                           std::string(source->substr(first_line_end));
   Shader shader(glCreateShader(stage));
-  const char* text = source->data();
-  const GLint length = static_cast<GLint>(source->size());
-  glShaderSource(shader.id(), 1, &text, &length);
+  const char* text_pointer = text.c_str();
+  const GLint length = static_cast<GLint>(text.size());
+  glShaderSource(shader.id(), 1, &text_pointer, &length);
   glCompileShader(shader.id());
   GLint ok = 0;
   glGetShaderiv(shader.id(), GL_COMPILE_STATUS, &ok);
@@ -77,9 +82,9 @@ Sampler make_linear_clamp_sampler() {
   return Sampler(id);
 }
 
-Program make_program(std::string_view vertex_name, std::string_view fragment_name) {
-  const Shader vertex = compile(GL_VERTEX_SHADER, vertex_name);
-  const Shader fragment = compile(GL_FRAGMENT_SHADER, fragment_name);
+Program make_program(std::string_view vertex_name, std::string_view fragment_name, std::string_view defines) {
+  const Shader vertex = compile(GL_VERTEX_SHADER, vertex_name, defines);
+  const Shader fragment = compile(GL_FRAGMENT_SHADER, fragment_name, defines);
   Program program(glCreateProgram());
   glAttachShader(program.id(), vertex.id());
   glAttachShader(program.id(), fragment.id());

@@ -75,8 +75,9 @@ VertexArray make_vertex_array();
 // Bilinear, no mipmaps, clamped to the edge: how every view and intermediate texture is read.
 Sampler make_linear_clamp_sampler();
 // Compiles and links the embedded shaders `vertex_name` + `fragment_name` (shaders/*.vert|frag);
-// throws GlError with the info log when that fails.
-Program make_program(std::string_view vertex_name, std::string_view fragment_name);
+// `defines` (e.g. "#define X\n") goes right after each shader's #version line. Throws GlError with
+// the info log when that fails.
+Program make_program(std::string_view vertex_name, std::string_view fragment_name, std::string_view defines = {});
 
 // Throws GlError naming `what` when glGetError reports an error.
 void check_error(std::string_view what);

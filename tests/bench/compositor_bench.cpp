@@ -2,12 +2,13 @@
 // Not a test: run by hand, results go to docs/PERFORMANCE.md. Two figures per level:
 //   render    both eyes from textures already on the GPU into an FBO (the video path);
 //   compose   GlCompositor::compose(): upload both float views, render, read both eyes back.
-// Each is the median of several runs after a warm-up run, timed around glFinish.
+// Each is the median of several runs after a warm-up run, timed up to glFinish.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -30,18 +31,16 @@ nelf::Image test_view(int width, int height) {
   return image;
 }
 
-template <class F>
-double median_ms(int runs, F&& body) {
-  body();  // warm-up: shader compilation, texture allocation
-  std::vector<double> ms;
-  for (int i = 0; i < runs; ++i) {
-    const auto start = clock_type::now();
-    body();
-    glFinish();
-    ms.push_back(std::chrono::duration<double, std::milli>(clock_type::now() - start).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
+double elapsed_ms(const std::function<void()>& body) {
+  const auto start = clock_type::now();
+  body();
+  glFinish();
+  return std::chrono::duration<double, std::milli>(clock_type::now() - start).count();
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
 }
 
 }  // namespace
@@ -64,16 +63,28 @@ int main(int argc, char** argv) {
     std::printf("renderer: %s (%s), %d runs per figure, hmz-t1, 2 x 1920x1080 views, render from RGBA%s\n",
                 context->renderer().c_str(), context->device().c_str(), runs, format_name.c_str());
     std::printf("%-6s %12s %8s %14s %8s\n", "fsaa", "render ms", "ratio", "compose ms", "ratio");
-    double render_base = 0, compose_base = 0;
-    for (int fsaa : {0, 1, 4, 16}) {
-      nelf::GlCompositor compositor(profile, {fsaa}, context);
-      const double render = median_ms(runs, [&] {
-        compositor.render_eye(nelf::Eye::left, {left.id(), 1920, 1080, 0.0}, {target.id(), 0, 0});
-        compositor.render_eye(nelf::Eye::right, {right.id(), 1920, 1080, 0.0}, {target.id(), 0, panel[1]});
-      });
-      const double compose = median_ms(runs, [&] { compositor.compose(views); });
-      if (fsaa == 0) render_base = render, compose_base = compose;
-      std::printf("%-6d %12.1f %8.2f %14.1f %8.2f\n", fsaa, render, render / render_base, compose,
+    // The levels are interleaved run by run, so load from other processes on a shared machine
+    // hits all of them alike; the first run of each (shader compilation, allocation) is dropped.
+    const int levels[] = {0, 1, 4, 16};
+    std::vector<std::unique_ptr<nelf::GlCompositor>> compositors;
+    for (int fsaa : levels)
+      compositors.push_back(std::make_unique<nelf::GlCompositor>(profile, nelf::CompositorOptions{fsaa}, context));
+    std::vector<std::vector<double>> render_ms(4), compose_ms(4);
+    for (int run = 0; run <= runs; ++run) {
+      for (std::size_t level = 0; level < compositors.size(); ++level) {
+        nelf::GlCompositor& compositor = *compositors[level];
+        const double render = elapsed_ms([&] {
+          compositor.render_eye(nelf::Eye::left, {left.id(), 1920, 1080, 0.0}, {target.id(), 0, 0});
+          compositor.render_eye(nelf::Eye::right, {right.id(), 1920, 1080, 0.0}, {target.id(), 0, panel[1]});
+        });
+        const double compose = elapsed_ms([&] { compositor.compose(views); });
+        if (run > 0) render_ms[level].push_back(render), compose_ms[level].push_back(compose);
+      }
+    }
+    const double render_base = median(render_ms[0]), compose_base = median(compose_ms[0]);
+    for (std::size_t level = 0; level < compositors.size(); ++level) {
+      const double render = median(render_ms[level]), compose = median(compose_ms[level]);
+      std::printf("%-6d %12.1f %8.2f %14.1f %8.2f\n", levels[level], render, render / render_base, compose,
                   compose / compose_base);
     }
   } catch (const std::exception& e) {
