@@ -32,6 +32,12 @@ void set_uniform_int(GLuint program, const char* name, int x, int y) {
 
 float f(double x) { return static_cast<float>(x); }
 
+bool texture_has_format(const gl::Texture& texture, GLenum format) {
+  GLint current = 0;
+  glGetTextureLevelParameteriv(texture.id(), 0, GL_TEXTURE_INTERNAL_FORMAT, &current);
+  return static_cast<GLenum>(current) == format;
+}
+
 }  // namespace
 
 PrefilterPlan plan_prefilter(const EyeMapping& mapping, int width, int height, int subsamples) {
@@ -91,11 +97,16 @@ GlCompositor::~GlCompositor() {
 
 GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, int view_width, int view_height,
                                PrefilterTargets& t) {
-  const auto ensure = [](std::array<int, 2>& size, std::array<int, 2> wanted, gl::Texture& texture,
-                         gl::Framebuffer& fbo) {
-    if (size == wanted && texture) return;
+  // Intermediates keep the view's precision: 8-bit views (decoded 8-bit video) get RGBA8, which
+  // llvmpipe filters on its fast fixed-point path; anything deeper gets RGBA16F.
+  GLint view_format = 0;
+  glGetTextureLevelParameteriv(view_texture, 0, GL_TEXTURE_INTERNAL_FORMAT, &view_format);
+  const GLenum format = view_format == GL_RGBA8 || view_format == GL_SRGB8_ALPHA8 ? GL_RGBA8 : GL_RGBA16F;
+  const auto ensure = [format](std::array<int, 2>& size, std::array<int, 2> wanted, gl::Texture& texture,
+                               gl::Framebuffer& fbo) {
+    if (size == wanted && texture && texture_has_format(texture, format)) return;
     fbo.reset();
-    texture = gl::make_texture_2d(GL_RGBA16F, wanted[0], wanted[1]);
+    texture = gl::make_texture_2d(format, wanted[0], wanted[1]);
     fbo = gl::make_framebuffer(texture);
     size = wanted;
   };

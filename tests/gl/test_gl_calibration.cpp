@@ -87,8 +87,8 @@ TEST(GlCalibration, EveryGeometryKeyAgreesWithTheReference) {
     const double db_unchanged = psnr(sixteen[0], base_reference);
     std::printf("%-40s fsaa 16: %.2f dB, fsaa 1: %.2f dB vs its reference; %.2f dB vs the unchanged one\n",
                 key.name.c_str(), db16, db1, db_unchanged);
-    EXPECT_GE(db16, 35.0) << key.name;
-    EXPECT_GE(db1, 27.0) << key.name;
+    EXPECT_GE(db16, 45.0) << key.name;
+    EXPECT_GE(db1, 40.0) << key.name;
     EXPECT_GE(db16 - db_unchanged, 10.0) << key.name << " did not change the output";
   }
 }
