@@ -3,9 +3,12 @@
 // llvmpipe) with exactly the geometry of compositor/mapping.cpp, antialiased per CompositorOptions:
 //   fsaa 0   one bilinear tap of the full-resolution view per pixel (comparison only);
 //   fsaa 1   the view prefiltered once per frame to the pixel footprint (a block-mean pass and a
-//            separable box pass into a small texture shared by all lenslets), one tap per pixel;
-//   fsaa 4   prefilter at the sub-sample footprint + 2×2 stratified sub-samples per pixel;
-//   fsaa 16  prefilter at the sub-sample footprint + 4×4 sub-samples.
+//            separable box pass into a small texture shared by all lenslets, black beyond the
+//            screen's edge), one tap per pixel; pixels straddling an elemental-image border
+//            (drawn again as thin strips along the borders) take one tap per lens, area-weighted;
+//   fsaa 4   prefilter at the sub-sample footprint + 2×2 stratified sub-apertures per pixel;
+//   fsaa 16  prefilter at the sub-sample footprint + 4×4 sub-apertures.
+// Prefilter textures are RGBA8 for RGBA8 views (fast on llvmpipe), RGBA16F otherwise.
 // compose() works on CPU Images; render_eye() is the lower-level entry for video: it renders from an
 // existing GL texture into a region of any framebuffer (e.g. straight into the packed HDMI frame).
 //
@@ -109,6 +112,7 @@ class GlCompositor final : public Compositor {
   std::array<EyeTarget, 2> eye_targets_;               // per eye, for compose()
 };
 
+// The helpers below need a current context (e.g. GlCompositor::context().make_current()).
 // A texture holding `image` in `internal_format` (GL_RGBA16F keeps 10-bit sources' precision;
 // GL_RGBA8 is what 8-bit video decodes to; GL_RGBA32F is exact but samples slowly on llvmpipe).
 gl::Texture upload_texture(const Image& image, GLenum internal_format = GL_RGBA16F);

@@ -6,6 +6,8 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <string_view>
 #include <vector>
 
@@ -53,6 +55,29 @@ bool has_extension(const char* list, std::string_view name) {
   return false;
 }
 
+// EGL hands out one EGLDisplay per device and eglTerminate ends it for every user in the process,
+// so initialisations are counted and only the last owner terminates.
+std::mutex display_mutex;
+std::map<EGLDisplay, int> display_users;
+
+bool initialize_display(EGLDisplay display) {
+  std::lock_guard lock(display_mutex);
+  EGLint major = 0, minor = 0;
+  if (!eglInitialize(display, &major, &minor)) return false;
+  ++display_users[display];
+  return true;
+}
+
+void release_display(EGLDisplay display) {
+  std::lock_guard lock(display_mutex);
+  const auto it = display_users.find(display);
+  if (it == display_users.end()) return;
+  if (--it->second == 0) {
+    display_users.erase(it);
+    eglTerminate(display);
+  }
+}
+
 // A display plus a desktop GL 4.5 core context on it, or the reason it failed.
 struct Attempt {
   EGLDisplay display = EGL_NO_DISPLAY;
@@ -66,14 +91,13 @@ Attempt try_display(EGLDisplay display) {
     a.failure = "no display (" + egl_error_name(eglGetError()) + ")";
     return a;
   }
-  EGLint major = 0, minor = 0;
-  if (!eglInitialize(display, &major, &minor)) {
+  if (!initialize_display(display)) {
     a.failure = "eglInitialize failed (" + egl_error_name(eglGetError()) + ")";
     return a;
   }
   const char* extensions = eglQueryString(display, EGL_EXTENSIONS);
   const auto fail = [&](std::string why) {
-    eglTerminate(display);
+    release_display(display);
     a.failure = std::move(why);
     return a;
   };
@@ -203,7 +227,7 @@ EglContext::~EglContext() {
   if (display_) {
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (context_) eglDestroyContext(display_, context_);
-    eglTerminate(display_);
+    release_display(display_);
   }
 }
 

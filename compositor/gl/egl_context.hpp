@@ -20,8 +20,9 @@ struct ContextOptions {
   std::optional<int> gpu;
 };
 
-// Owns an EGLDisplay (initialised) and an EGLContext, current on the creating thread.
-// Not copyable or movable: the GL objects created under it refer to it; hold it by pointer.
+// Owns an EGLContext on an initialised EGLDisplay (shared with other EglContexts on the same
+// device; terminated when the last one goes), current on the creating thread. Not copyable or
+// movable: the GL objects created under it refer to it; hold it by (shared) pointer.
 class EglContext {
  public:
   explicit EglContext(const ContextOptions& options = {});

@@ -110,6 +110,7 @@ TEST(GlVsReference, HmzT1FullHdPhotoChart) {
 // The video path: an 8-bit view texture (as decoded frames arrive) through render_eye; the
 // prefilter then works in RGBA8 too. Still close to the float reference.
 TEST(GlVsReference, EightBitViewTextureThroughRenderEye) {
+  const auto context = shared_gl_context();  // current before the first GL call below
   const Profile profile = test::small_panel_profile();
   const View view{test::photo_chart(480, 270), 0.0};
   const Image reference = reference_eye(profile, view);
