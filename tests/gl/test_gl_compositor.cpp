@@ -46,6 +46,20 @@ TEST(GlContext, OutOfRangeGpuIsAClearError) {
   }
 }
 
+// EGL has one display per device: a second context coming and going must leave the first usable.
+TEST(GlContext, SecondContextOnTheSameDeviceLeavesTheFirstWorking) {
+  const auto context = shared_gl_context();
+  {
+    gl::EglContext second;
+    EXPECT_EQ(second.renderer(), context->renderer());
+  }
+  GlCompositor compositor(test::small_panel_profile(), {0}, context);  // makes the first current again
+  Image grey(48, 27);
+  for (Rgba& p : grey.pixels()) p = {0.5f, 0.5f, 0.5f, 1.f};
+  const Image eye = compositor.compose({{grey, 0.0}, {grey, 0.0}})[0];
+  EXPECT_NEAR(eye.at(160, 90).r, 0.5f, 1e-3);
+}
+
 TEST(GlContext, MalformedNelfGpuIsAClearError) {
   setenv("NELF_GPU", "first", 1);
   EXPECT_THROW(gl::requested_gpu({}), gl::GlError);
