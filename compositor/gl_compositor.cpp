@@ -1,0 +1,261 @@
+#include "compositor/gl_compositor.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace nelf {
+
+namespace {
+
+// Prefiltered samples per (sub-)sample footprint. The box pass is band-limited to ~1/F, so 3
+// samples per F keep the final bilinear tap's extra blur small (its variance is compensated below)
+// while the prefiltered texture stays tiny (~430×240 for a 1920×1080 view on hmz-t1).
+constexpr double samples_per_footprint = 3.0;
+
+int subsamples_per_axis(int fsaa) { return fsaa == 16 ? 4 : fsaa == 4 ? 2 : 1; }
+
+void set_uniform(GLuint program, const char* name, float x) {
+  glProgramUniform1f(program, glGetUniformLocation(program, name), x);
+}
+void set_uniform(GLuint program, const char* name, float x, float y) {
+  glProgramUniform2f(program, glGetUniformLocation(program, name), x, y);
+}
+void set_uniform_int(GLuint program, const char* name, int x) {
+  glProgramUniform1i(program, glGetUniformLocation(program, name), x);
+}
+void set_uniform_int(GLuint program, const char* name, int x, int y) {
+  glProgramUniform2i(program, glGetUniformLocation(program, name), x, y);
+}
+
+float f(double x) { return static_cast<float>(x); }
+
+bool texture_has_format(const gl::Texture& texture, GLenum format) {
+  GLint current = 0;
+  glGetTextureLevelParameteriv(texture.id(), 0, GL_TEXTURE_INTERNAL_FORMAT, &current);
+  return static_cast<GLenum>(current) == format;
+}
+
+}  // namespace
+
+PrefilterPlan plan_prefilter(const EyeMapping& mapping, int width, int height, int subsamples) {
+  PrefilterPlan plan;
+  const Vec2 footprint_uv = pixel_footprint_uv(mapping);
+  const int size[2] = {width, height};
+  plan.footprint = {footprint_uv.x * width / subsamples, footprint_uv.y * height / subsamples};
+  plan.enabled = plan.footprint[0] > 1.0 || plan.footprint[1] > 1.0;
+  if (!plan.enabled) return plan;
+  for (int axis = 0; axis < 2; ++axis) {
+    const double footprint = plan.footprint[axis];
+    const int count =
+        std::max(1, static_cast<int>(std::lround(size[axis] / std::max(1.0, footprint / samples_per_footprint))));
+    plan.output[axis] = std::min(count, size[axis]);
+    const double spacing = static_cast<double>(size[axis]) / plan.output[axis];
+    plan.spacing[axis] = spacing;
+    plan.block[axis] = spacing >= 4.0 ? 4 : spacing >= 2.0 ? 2 : 1;
+    plan.reduced[axis] = (size[axis] + plan.block[axis] - 1) / plan.block[axis];
+    // The reference is a box of F over the bilinear view (variance F²/12 + 1/6). Here the block
+    // mean (R²/12), the box (B²/12) and the final bilinear tap on the prefiltered grid (g²/6) add
+    // up; B is chosen so the total variance matches.
+    const double box_squared =
+        footprint * footprint + 2.0 - plan.block[axis] * plan.block[axis] - 2.0 * spacing * spacing;
+    plan.box[axis] = std::sqrt(std::max(box_squared, 1.0));
+    // The screen is black around the view: extend the grid until the box lies wholly outside, so
+    // the outermost samples are black and the clamped texture stays black beyond them.
+    plan.margin[axis] = static_cast<int>(std::ceil((0.5 * plan.box[axis] + plan.block[axis]) / spacing)) + 1;
+    plan.output[axis] += 2 * plan.margin[axis];
+  }
+  return plan;
+}
+
+GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shared_ptr<gl::EglContext> context)
+    : context_(context ? std::move(context) : std::make_shared<gl::EglContext>()),
+      profile_(std::move(profile)),
+      options_(options) {
+  validate_fsaa(options_.fsaa);
+  context_->make_current();
+  empty_vertex_array_ = gl::make_vertex_array();
+  sampler_ = gl::make_linear_clamp_sampler();
+  elemental_program_ = gl::make_program("fullscreen.vert", "elemental.frag");
+  border_program_ = gl::make_program("border_strips.vert", "elemental.frag", "#define NELF_AREA_SAMPLE 1\n");
+  reduce_program_ = gl::make_program("fullscreen.vert", "prefilter_reduce.frag");
+  box_program_ = gl::make_program("fullscreen.vert", "prefilter_box.frag");
+  for (GLuint program : {elemental_program_.id(), border_program_.id(), reduce_program_.id(), box_program_.id()})
+    set_uniform_int(program, program == box_program_.id() ? "u_input" : "u_view", 0);
+  gl::check_error("creating the compositor's programs");
+}
+
+GlCompositor::~GlCompositor() {
+  // The GL objects are deleted by their owners; the context they belong to must be current.
+  try {
+    context_->make_current();
+  } catch (const gl::GlError&) {
+  }
+}
+
+GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, int view_width, int view_height,
+                               PrefilterTargets& t) {
+  // Intermediates keep the view's precision: 8-bit views (decoded 8-bit video) get RGBA8, which
+  // llvmpipe filters on its fast fixed-point path; anything deeper gets RGBA16F.
+  GLint view_format = 0;
+  glGetTextureLevelParameteriv(view_texture, 0, GL_TEXTURE_INTERNAL_FORMAT, &view_format);
+  const GLenum format = view_format == GL_RGBA8 || view_format == GL_SRGB8_ALPHA8 ? GL_RGBA8 : GL_RGBA16F;
+  const auto ensure = [format](std::array<int, 2>& size, std::array<int, 2> wanted, gl::Texture& texture,
+                               gl::Framebuffer& fbo) {
+    if (size == wanted && texture && texture_has_format(texture, format)) return;
+    fbo.reset();
+    texture = gl::make_texture_2d(format, wanted[0], wanted[1]);
+    fbo = gl::make_framebuffer(texture);
+    size = wanted;
+  };
+  const bool reduce = plan.block[0] > 1 || plan.block[1] > 1;
+  if (reduce) ensure(t.reduced, plan.reduced, t.reduced_texture, t.reduced_fbo);
+  ensure(t.horizontal, {plan.output[0], plan.reduced[1]}, t.horizontal_texture, t.horizontal_fbo);
+  ensure(t.output, plan.output, t.output_texture, t.output_fbo);
+
+  glBindVertexArray(empty_vertex_array_.id());
+  glBindSampler(0, sampler_.id());
+  GLuint input = view_texture;
+  if (reduce) {
+    glBindFramebuffer(GL_FRAMEBUFFER, t.reduced_fbo.id());
+    glViewport(0, 0, plan.reduced[0], plan.reduced[1]);
+    glUseProgram(reduce_program_.id());
+    set_uniform_int(reduce_program_.id(), "u_block", plan.block[0], plan.block[1]);
+    glBindTextureUnit(0, input);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    input = t.reduced_texture.id();
+  }
+  glUseProgram(box_program_.id());
+  const int view_size[2] = {view_width, view_height};
+  const auto box_pass = [&](int axis, GLuint fbo, std::array<int, 2> size, double cell) {
+    set_uniform(box_program_.id(), "u_out_origin", f(-plan.margin[axis] * plan.spacing[axis]));
+    set_uniform(box_program_.id(), "u_view_extent", f(view_size[axis]));
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, size[0], size[1]);
+    set_uniform_int(box_program_.id(), "u_axis", axis);
+    set_uniform(box_program_.id(), "u_cell_size", f(cell));
+    set_uniform(box_program_.id(), "u_out_spacing", f(plan.spacing[axis]));
+    set_uniform(box_program_.id(), "u_box_width", f(plan.box[axis]));
+    glBindTextureUnit(0, input);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  };
+  box_pass(0, t.horizontal_fbo.id(), t.horizontal, plan.block[0]);
+  input = t.horizontal_texture.id();
+  box_pass(1, t.output_fbo.id(), t.output, plan.block[1]);
+  return t.output_texture.id();
+}
+
+void GlCompositor::render_eye(Eye eye, const GlTextureView& view, const GlTarget& target) {
+  if (view.texture == 0 || view.width <= 0 || view.height <= 0)
+    throw std::invalid_argument("GlCompositor::render_eye: no view texture");
+  if (target.framebuffer == 0) throw std::invalid_argument("GlCompositor::render_eye: target framebuffer 0");
+  const EyeMapping m = make_eye_mapping(profile_, eye, view.aspect());
+  const int subsamples = subsamples_per_axis(options_.fsaa);
+
+  GLuint source = view.texture;
+  float scale[2] = {1.f, 1.f}, offset[2] = {0.f, 0.f};
+  bool cut_outside = true;
+  if (options_.fsaa != 0) {
+    const PrefilterPlan plan = plan_prefilter(m, view.width, view.height, subsamples);
+    if (plan.enabled) {
+      source = prefilter(plan, view.texture, view.width, view.height, prefilter_targets_[static_cast<int>(eye)]);
+      for (int axis = 0; axis < 2; ++axis) {
+        // uv ∈ [0, 1] covers the samples between the margins.
+        scale[axis] = f(static_cast<double>(plan.output[axis] - 2 * plan.margin[axis]) / plan.output[axis]);
+        offset[axis] = f(static_cast<double>(plan.margin[axis]) / plan.output[axis]);
+      }
+      cut_outside = false;
+    }
+  }
+
+  // Pass 1 (every pixel): point samples. Pass 2 (fsaa >= 1, lens arrays): strips along the
+  // elemental-image borders redo the pixels there with the per-lens area split.
+  for (const GLuint p : {elemental_program_.id(), border_program_.id()}) {
+    set_uniform(p, "u_texture_scale", scale[0], scale[1]);
+    set_uniform(p, "u_texture_offset", offset[0], offset[1]);
+    set_uniform_int(p, "u_cut_outside", cut_outside ? 1 : 0);
+    set_uniform(p, "u_region_origin", f(target.x), f(target.y));
+    set_uniform(p, "u_panel", f(m.panel[0]), f(m.panel[1]));
+    set_uniform(p, "u_pixel_pitch", f(m.pixel_pitch_mm.x), f(m.pixel_pitch_mm.y));
+    set_uniform(p, "u_shift", f(m.shift_px.x), f(m.shift_px.y));
+    set_uniform(p, "u_rotation", f(m.rotation_cos), f(m.rotation_sin));
+    set_uniform_int(p, "u_has_lens_array", m.has_lens_array ? 1 : 0);
+    set_uniform_int(p, "u_subsamples", subsamples);
+    if (m.has_lens_array) {
+      set_uniform(p, "u_to_lens_plane", f(m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm)));
+      set_uniform(p, "u_lattice_offset", f(m.lattice_offset_mm.x), f(m.lattice_offset_mm.y));
+      set_uniform(p, "u_lens_pitch", f(m.lens_pitch_mm));
+      set_uniform_int(p, "u_first_lens", m.first_lens[0], m.first_lens[1]);
+      set_uniform_int(p, "u_lenses", m.lenses[0], m.lenses[1]);
+      set_uniform(p, "u_chief_ray_scale", f((m.render_distance_mm - m.eye_relief_mm) / m.gap_mm));
+      set_uniform(p, "u_screen_centre", f(m.screen_centre_mm.x), f(m.screen_centre_mm.y));
+      set_uniform(p, "u_screen_size", f(m.screen_size_mm.x), f(m.screen_size_mm.y));
+    } else {
+      set_uniform(p, "u_view_size", f(m.view_size_mm.x), f(m.view_size_mm.y));
+    }
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+  glViewport(target.x, target.y, m.panel[0], m.panel[1]);
+  glBindVertexArray(empty_vertex_array_.id());
+  glBindSampler(0, sampler_.id());
+  glBindTextureUnit(0, source);
+  glUseProgram(elemental_program_.id());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  if (options_.fsaa != 0 && m.has_lens_array) {
+    glUseProgram(border_program_.id());
+    glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
+  }
+  gl::check_error("rendering an eye image");
+}
+
+EyeImages GlCompositor::compose(const StereoPair& views) {
+  context_->make_current();
+  EyeImages eyes;
+  for (Eye eye : {Eye::left, Eye::right}) {
+    const int e = static_cast<int>(eye);
+    const View& v = eye == Eye::left ? views.left : views.right;
+    if (v.image.empty()) throw std::invalid_argument("GlCompositor::compose: empty view");
+    UploadedView& up = uploads_[e];
+    if (!up.texture || up.width != v.image.width() || up.height != v.image.height()) {
+      up.texture = upload_texture(v.image);
+      up.width = v.image.width();
+      up.height = v.image.height();
+    } else {
+      update_texture(up.texture, v.image);
+    }
+    EyeTarget& target = eye_targets_[e];
+    if (!target.texture) {
+      target.texture = gl::make_texture_2d(GL_RGBA16F, panel()[0], panel()[1]);
+      target.fbo = gl::make_framebuffer(target.texture);
+    }
+    render_eye(eye, {up.texture.id(), up.width, up.height, v.display_aspect}, {target.fbo.id(), 0, 0});
+    eyes[e] = read_back(target.fbo.id(), 0, 0, panel()[0], panel()[1]);
+  }
+  return eyes;
+}
+
+gl::Texture upload_texture(const Image& image, GLenum internal_format) {
+  gl::Texture texture = gl::make_texture_2d(internal_format, image.width(), image.height());
+  update_texture(texture, image);
+  return texture;
+}
+
+void update_texture(const gl::Texture& texture, const Image& image) {
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(texture.id(), 0, 0, 0, image.width(), image.height(), GL_RGBA, GL_FLOAT, image.data());
+  gl::check_error("uploading a view");
+}
+
+Image read_back(GLuint framebuffer, int x, int y, int width, int height) {
+  Image image(width, height);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
+  glNamedFramebufferReadBuffer(framebuffer, GL_COLOR_ATTACHMENT0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(x, y, width, height, GL_RGBA, GL_FLOAT, image.data());
+  gl::check_error("reading an image back");
+  return image;
+}
+
+}  // namespace nelf

@@ -1,0 +1,136 @@
+#version 450 core
+// One eye's elemental images: the per-pixel mapping of DESIGN.md §3, the same math as
+// compositor/mapping.cpp (view_coordinate) in float. Pixel positions are taken relative to the
+// panel's pixel grid, so float keeps sub-micrometre precision.
+//
+// Compiled twice: as is for pass 1 (point samples over the whole region), and with
+// NELF_AREA_SAMPLE defined for the border strips (a compile-time switch: llvmpipe would otherwise
+// evaluate both sides of a run-time choice for every pixel).
+//
+// Memory layout: row 0 of the target region is the top row of the eye image (as in nelf::Image);
+// the view textures likewise hold the image's top row first, so t (down) is the texture's y.
+
+uniform sampler2D u_view;      // the view, or its footprint-prefiltered version
+uniform vec2 u_texture_scale;  // u_view coordinate = uv * scale + offset: the prefiltered
+uniform vec2 u_texture_offset; // texture extends beyond the screen (black margin)
+uniform bool u_cut_outside;    // sampling the view itself: black outside the screen
+uniform vec2 u_region_origin;  // lower-left corner of the eye's region in the target (pixels)
+uniform vec2 u_panel;          // panel resolution
+uniform vec2 u_pixel_pitch;    // mm
+uniform vec2 u_shift;          // calibration shift (pixels, right/down)
+uniform vec2 u_rotation;       // cos, sin of the lattice (or, stock, image) rotation
+uniform bool u_has_lens_array;
+uniform float u_to_lens_plane;  // d_e / (d_e + d_l)
+uniform vec2 u_lattice_offset;  // mm
+uniform float u_lens_pitch;     // mm, calibrated
+uniform ivec2 u_first_lens;
+uniform ivec2 u_lenses;
+uniform float u_chief_ray_scale;  // (d_r - d_e) / d_l
+uniform vec2 u_screen_centre;     // mm
+uniform vec2 u_screen_size;       // mm
+uniform vec2 u_view_size;         // mm, stock devices
+uniform int u_subsamples;         // per axis: 1, 2 or 4
+
+out vec4 colour;
+
+vec2 rotate(vec2 v, float sign_) {
+  const float c = u_rotation.x, s = sign_ * u_rotation.y;
+  return vec2(c * v.x - s * v.y, s * v.x + c * v.y);
+}
+
+vec2 display_position(vec2 pixel) {
+  return vec2((pixel.x - 0.5 * u_panel.x - u_shift.x) * u_pixel_pitch.x,
+              (0.5 * u_panel.y - pixel.y + u_shift.y) * u_pixel_pitch.y);
+}
+
+bool inside(vec2 uv) { return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))); }
+
+// The view at screen coordinate uv. The prefiltered texture already fades to black across the
+// screen's edge over the footprint; the raw view is cut there.
+vec3 tap(vec2 uv) {
+  if (u_cut_outside && !inside(uv)) return vec3(0.0);
+  return textureLod(u_view, uv * u_texture_scale + u_texture_offset, 0.0).rgb;
+}
+
+// The view at display position s as seen through lens (m, n): black outside the lit block or the screen.
+vec3 through_lens(vec2 s, ivec2 lens) {
+  if (any(lessThan(lens, u_first_lens)) || any(greaterThanEqual(lens, u_first_lens + u_lenses))) return vec3(0.0);
+  const vec2 c = u_lattice_offset + rotate(vec2(lens) * u_lens_pitch, 1.0);
+  const vec2 v = c + (s - c) * u_chief_ray_scale;  // chief ray back to the screen plane
+  const vec2 uv =
+      vec2((v.x - u_screen_centre.x) / u_screen_size.x + 0.5, 0.5 - (v.y - u_screen_centre.y) / u_screen_size.y);
+  return tap(uv);
+}
+
+// Position in the lens lattice (units of the lens pitch, rotated frame) of display position s.
+vec2 lattice_position(vec2 s) { return rotate(s * u_to_lens_plane - u_lattice_offset, -1.0) / u_lens_pitch; }
+
+// view_coordinate(display_position_mm(x, y)) followed by a tap; black where the display is black.
+vec3 point_sample(vec2 pixel) {
+  const vec2 s = display_position(pixel);
+  if (!u_has_lens_array) {
+    const vec2 r = rotate(s, -1.0);
+    const vec2 uv = vec2(r.x / u_view_size.x + 0.5, 0.5 - r.y / u_view_size.y);
+    return tap(uv);
+  }
+  return through_lens(s, ivec2(floor(lattice_position(s) + 0.5)));
+}
+
+// One tap per lens that an `aperture`×`aperture` pixel square centred on `pixel` overlaps: a
+// (sub-)pixel straddling an elemental image border mixes both sides by area, as the reference's
+// sub-samples do; each part is tapped at its centroid. Interior ones (almost all) take one tap. Exact for an unrotated lattice;
+// for a rotated one the aperture is approximated by an axis-aligned square in lattice coordinates.
+vec3 area_sample(vec2 pixel, float aperture) {
+  if (!u_has_lens_array) return point_sample(pixel);
+  const vec2 s = display_position(pixel);
+  const vec2 q = lattice_position(s);
+  const vec2 half_pixel = 0.5 * aperture * u_pixel_pitch * u_to_lens_plane / u_lens_pitch;
+  const vec2 own = floor(q + 0.5);
+  const vec2 lo = q - half_pixel, hi = q + half_pixel;
+  // Per axis: which neighbour (±1, or 0 for none) the aperture reaches into, and the split point.
+  const vec2 step_ = mix(mix(vec2(0.0), vec2(-1.0), lessThan(lo, own - 0.5)), vec2(1.0), greaterThan(hi, own + 0.5));
+  const vec2 border = own + 0.5 * step_;
+  // Own part [max(lo, own-½), min(hi, own+½)], neighbour part the rest.
+  const vec2 own_lo = max(lo, own - 0.5), own_hi = min(hi, own + 0.5);
+  const vec2 own_weight = (own_hi - own_lo) / (hi - lo);
+  const vec2 own_centre = 0.5 * (own_lo + own_hi);
+  const vec2 other_centre = mix(0.5 * (border + hi), 0.5 * (lo + border), lessThan(step_, vec2(0.0)));
+  vec3 sum = own_weight.x * own_weight.y *
+             through_lens(s + rotate((own_centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane, ivec2(own));
+  if (step_.x != 0.0) {
+    const vec2 centre = vec2(other_centre.x, own_centre.y);
+    sum +=
+        (1.0 - own_weight.x) * own_weight.y *
+        through_lens(s + rotate((centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane, ivec2(own + vec2(step_.x, 0.0)));
+  }
+  if (step_.y != 0.0) {
+    const vec2 centre = vec2(own_centre.x, other_centre.y);
+    sum +=
+        own_weight.x * (1.0 - own_weight.y) *
+        through_lens(s + rotate((centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane, ivec2(own + vec2(0.0, step_.y)));
+  }
+  if (step_.x != 0.0 && step_.y != 0.0) {
+    sum += (1.0 - own_weight.x) * (1.0 - own_weight.y) *
+           through_lens(s + rotate((other_centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane, ivec2(own + step_));
+  }
+  return sum;
+}
+
+void main() {
+  // Stratified sub-samples (1, 2×2 or 4×4). Pass 1 point-samples each; the border-strip pass
+  // (border_strips.vert) area-samples each sub-aperture, splitting it between the lenses it overlaps.
+  const vec2 pixel_corner = floor(gl_FragCoord.xy - u_region_origin);
+  const float step_ = 1.0 / float(u_subsamples);
+  vec3 sum = vec3(0.0);
+  for (int sy = 0; sy < u_subsamples; ++sy) {
+    for (int sx = 0; sx < u_subsamples; ++sx) {
+      const vec2 centre = pixel_corner + (vec2(sx, sy) + 0.5) * step_;
+#ifdef NELF_AREA_SAMPLE
+      sum += area_sample(centre, step_);
+#else
+      sum += point_sample(centre);
+#endif
+    }
+  }
+  colour = vec4(sum * (step_ * step_), 1.0);
+}

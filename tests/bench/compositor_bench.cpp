@@ -1,0 +1,94 @@
+// Compositor cost per frame pair at each fsaa level (DESIGN.md §10): hmz-t1, two 1920×1080 views.
+// Not a test: run by hand, results go to docs/PERFORMANCE.md. Two figures per level:
+//   render    both eyes from textures already on the GPU into an FBO (the video path);
+//   compose   GlCompositor::compose(): upload both float views, render, read both eyes back.
+// Each is the median of several runs after a warm-up run, timed up to glFinish.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "compositor/gl_compositor.hpp"
+
+namespace {
+
+using clock_type = std::chrono::steady_clock;
+
+nelf::Image test_view(int width, int height) {
+  nelf::Image image(width, height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const double u = x / double(width), t = y / double(height);
+      const float v = static_cast<float>(0.5 + 0.5 * std::sin(2 * std::numbers::pi * (30 * u * u + 17 * t)));
+      image.at(x, y) = {v, static_cast<float>(u), static_cast<float>(t), 1.f};
+    }
+  return image;
+}
+
+double elapsed_ms(const std::function<void()>& body) {
+  const auto start = clock_type::now();
+  body();
+  glFinish();
+  return std::chrono::duration<double, std::milli>(clock_type::now() - start).count();
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const int runs = argc > 1 ? std::max(1, std::atoi(argv[1])) : 9;
+    auto context = std::make_shared<nelf::gl::EglContext>();
+    const nelf::Profile profile = nelf::load_profile("hmz-t1");
+    const nelf::StereoPair views{{test_view(1920, 1080), 0.0}, {test_view(1920, 1080), 0.0}};
+    // The video path's views: 8-bit textures as decoded frames arrive (argument 2: "16f" or "32f").
+    const std::string format_name = argc > 2 ? argv[2] : "8";
+    const GLenum format = format_name == "32f" ? GL_RGBA32F : format_name == "16f" ? GL_RGBA16F : GL_RGBA8;
+    const nelf::gl::Texture left = nelf::upload_texture(views.left.image, format);
+    const nelf::gl::Texture right = nelf::upload_texture(views.right.image, format);
+    const auto panel = profile.display.resolution;
+    const nelf::gl::Texture target_texture = nelf::gl::make_texture_2d(GL_RGBA8, panel[0], 2 * panel[1]);
+    const nelf::gl::Framebuffer target = nelf::gl::make_framebuffer(target_texture);
+
+    std::printf("renderer: %s (%s), %d runs per figure, hmz-t1, 2 x 1920x1080 views, render from RGBA%s\n",
+                context->renderer().c_str(), context->device().c_str(), runs, format_name.c_str());
+    std::printf("%-6s %12s %8s %14s %8s\n", "fsaa", "render ms", "ratio", "compose ms", "ratio");
+    // The levels are interleaved run by run, so load from other processes on a shared machine
+    // hits all of them alike; the first run of each (shader compilation, allocation) is dropped.
+    const int levels[] = {0, 1, 4, 16};
+    std::vector<std::unique_ptr<nelf::GlCompositor>> compositors;
+    for (int fsaa : levels)
+      compositors.push_back(std::make_unique<nelf::GlCompositor>(profile, nelf::CompositorOptions{fsaa}, context));
+    std::vector<std::vector<double>> render_ms(4), compose_ms(4);
+    for (int run = 0; run <= runs; ++run) {
+      for (std::size_t level = 0; level < compositors.size(); ++level) {
+        nelf::GlCompositor& compositor = *compositors[level];
+        const double render = elapsed_ms([&] {
+          compositor.render_eye(nelf::Eye::left, {left.id(), 1920, 1080, 0.0}, {target.id(), 0, 0});
+          compositor.render_eye(nelf::Eye::right, {right.id(), 1920, 1080, 0.0}, {target.id(), 0, panel[1]});
+        });
+        const double compose = elapsed_ms([&] { compositor.compose(views); });
+        if (run > 0) render_ms[level].push_back(render), compose_ms[level].push_back(compose);
+      }
+    }
+    const double render_base = median(render_ms[0]), compose_base = median(compose_ms[0]);
+    for (std::size_t level = 0; level < compositors.size(); ++level) {
+      const double render = median(render_ms[level]), compose = median(compose_ms[level]);
+      std::printf("%-6d %12.1f %8.2f %14.1f %8.2f\n", levels[level], render, render / render_base, compose,
+                  compose / compose_base);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "compositor_bench: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,31 @@
+#pragma once
+// Shared pieces of the GL tests: one headless context for the whole run, procedural test charts,
+// image comparison.
+#include <memory>
+#include <string>
+
+#include "compositor/gl/egl_context.hpp"
+#include "compositor/image.hpp"
+#include "compositor/profile.hpp"
+
+namespace nelf::test {
+
+// The process-wide context (EGL displays are per device, so one context serves every test).
+// MESA_SHADER_CACHE_DIR points to a temporary directory first, so tests never touch ~/.cache.
+std::shared_ptr<gl::EglContext> shared_gl_context();
+
+// Photo-like chart: smooth colour gradients, hard-edged shapes and mid-frequency texture.
+Image photo_chart(int width, int height);
+// Zone plate cos(k r²) whose local frequency rises to the view's Nyquist limit at the corners.
+Image zone_plate(int width, int height);
+
+// PSNR (dB, peak 1) over the RGB channels; +inf for identical images. Sizes must match.
+double psnr(const Image& a, const Image& b);
+// Largest absolute RGB difference.
+double max_abs_difference(const Image& a, const Image& b);
+
+// hmz-t1 with a 320×180 panel of 4× the pixel pitch (same physical size and optics, 16× fewer
+// pixels), so the 16×16 reference stays fast.
+Profile small_panel_profile();
+
+}  // namespace nelf::test
