@@ -253,15 +253,35 @@ struct VideoSource::Impl {
       if (format->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_AUDIO) ++info.audio_streams;
 
     const AVCodec* decoder = nullptr;
-    const int best = av_find_best_stream(format.get(), AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
-    if (best == AVERROR_STREAM_NOT_FOUND)
-      fail(info.audio_streams > 0 ? fmt::format("no video stream (only {} audio stream{})", info.audio_streams,
-                                                info.audio_streams == 1 ? "" : "s")
-                                  : std::string("no video stream"));
+    int best = av_find_best_stream(format.get(), AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
+    // Cover art (an audio file's picture) is a "video" stream of one frame: never the content.
+    auto is_moving_video = [](const AVStream* candidate) {
+      return candidate->codecpar->codec_type == AVMEDIA_TYPE_VIDEO &&
+             (candidate->disposition & AV_DISPOSITION_ATTACHED_PIC) == 0;
+    };
+    if (best >= 0 && !is_moving_video(format->streams[best])) {
+      best = AVERROR_STREAM_NOT_FOUND;
+      decoder = nullptr;
+      for (unsigned i = 0; i < format->nb_streams && decoder == nullptr; ++i) {
+        if (!is_moving_video(format->streams[i])) continue;
+        decoder = avcodec_find_decoder(format->streams[i]->codecpar->codec_id);
+        best = decoder != nullptr ? static_cast<int>(i) : AVERROR_DECODER_NOT_FOUND;
+      }
+    }
+    if (best == AVERROR_STREAM_NOT_FOUND) {
+      bool has_cover = false;
+      for (unsigned i = 0; i < format->nb_streams; ++i)
+        if ((format->streams[i]->disposition & AV_DISPOSITION_ATTACHED_PIC) != 0) has_cover = true;
+      std::string only;
+      if (info.audio_streams > 0)
+        only = fmt::format("{} audio stream{}", info.audio_streams, info.audio_streams == 1 ? "" : "s");
+      if (has_cover) only += only.empty() ? "a cover picture" : " and a cover picture";
+      fail(only.empty() ? std::string("no video stream") : fmt::format("no video stream (only {})", only));
+    }
     if (best == AVERROR_DECODER_NOT_FOUND) {
       const AVStream* first_video = nullptr;
       for (unsigned i = 0; i < format->nb_streams && first_video == nullptr; ++i)
-        if (format->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_VIDEO) first_video = format->streams[i];
+        if (is_moving_video(format->streams[i])) first_video = format->streams[i];
       const AVCodecID id = first_video != nullptr ? first_video->codecpar->codec_id : AV_CODEC_ID_NONE;
       if (id == AV_CODEC_ID_NONE) fail("unsupported video codec: FFmpeg does not know the stream's codec");
       fail(fmt::format("unsupported video codec '{}' (no decoder for it in this FFmpeg build)", avcodec_get_name(id)));

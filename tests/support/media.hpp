@@ -9,10 +9,11 @@
 namespace nelf::test {
 
 // Runs `ffmpeg ARGS OUTPUT` quietly, overwriting OUTPUT; throws with ffmpeg's own message on failure
-// so that a broken generator shows up as such and not as a decoder bug.
+// so that a broken generator shows up as such and not as a decoder bug. lavfi sources are endless:
+// ARGS must bound them (-frames:v, d=, -shortest); the timeout catches a forgotten bound.
 inline std::filesystem::path make_media(const std::filesystem::path& output, const std::string& args) {
-  const CommandResult result =
-      run_command("ffmpeg -nostdin -hide_banner -loglevel error -y " + args + " " + shell_quote(output.string()));
+  const CommandResult result = run_command("timeout 60 ffmpeg -nostdin -hide_banner -loglevel error -y " + args + " " +
+                                           shell_quote(output.string()));
   if (result.status != 0 || !std::filesystem::exists(output))
     throw std::runtime_error("ffmpeg could not generate " + output.string() + ": " + result.err);
   return output;

@@ -319,6 +319,14 @@ TEST_F(VideoSourceTest, RefusesAudioOnly) {
   EXPECT_NE(error.find("no video stream"), std::string::npos) << error;
 }
 
+TEST_F(VideoSourceTest, CoverArtIsNotVideo) {
+  const auto path = make_media(dir / "album.m4a",
+                               "-f lavfi -i sine=duration=0.3 -f lavfi -i color=c=red:s=64x64:d=0.1 -map 0 -map 1 "
+                               "-c:a aac -c:v png -frames:v 1 -disposition:v:0 attached_pic -shortest");
+  const std::string error = open_error(path);
+  EXPECT_NE(error.find("no video stream (only 1 audio stream and a cover picture)"), std::string::npos) << error;
+}
+
 TEST_F(VideoSourceTest, RefusesACodecWithoutDecoder) {
   const auto path = make_media(dir / "clip.mkv", "-f lavfi -i testsrc2=s=64x36:r=10 -frames:v 2 -c:v mpeg4");
   std::vector<std::uint8_t> bytes = read_bytes(path);
