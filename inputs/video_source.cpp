@@ -155,6 +155,18 @@ bool is_yuv_or_gray(AVPixelFormat format) {
   return desc != nullptr && (desc->flags & AV_PIX_FMT_FLAG_RGB) == 0 && (desc->flags & AV_PIX_FMT_FLAG_PAL) == 0;
 }
 
+// Whether samples in `format` tagged `range` use the full code range. Untagged YUV is limited
+// (video); untagged grey is full (stills, as swscale assumes); RGB and palettes are always full.
+bool is_full_range(AVPixelFormat format, AVColorRange range) {
+  bool jpeg = false;
+  without_jpeg_range(format, jpeg);
+  if (jpeg || !is_yuv_or_gray(format)) return true;
+  const AVPixFmtDescriptor* desc = av_pix_fmt_desc_get(format);
+  const bool gray = desc != nullptr && desc->nb_components <= 2;
+  if (gray) return range != AVCOL_RANGE_MPEG;
+  return range == AVCOL_RANGE_JPEG;
+}
+
 int bits_of(AVPixelFormat format) {
   const AVPixFmtDescriptor* desc = av_pix_fmt_desc_get(format);
   return desc != nullptr && desc->nb_components > 0 ? desc->comp[0].depth : 8;
@@ -324,14 +336,11 @@ struct VideoSource::Impl {
     info.bits_per_component = bits_of(pixel_format);
     info.matrix = matrix_from_av(par.color_space, info.matrix_tagged);
     if (!info.matrix_tagged) info.matrix = default_matrix_for_height(par.height);
-    bool full_range = par.color_range == AVCOL_RANGE_JPEG;
-    without_jpeg_range(pixel_format, full_range);
     if (!is_yuv_or_gray(pixel_format) && pixel_format != AV_PIX_FMT_NONE) {
-      full_range = true;
       info.matrix = ColorMatrix::rgb;
       info.matrix_tagged = true;
     }
-    info.range = full_range ? ColorRange::full : ColorRange::limited;
+    info.range = is_full_range(pixel_format, par.color_range) ? ColorRange::full : ColorRange::limited;
     info.stream_stereo = stereo_metadata_from_stream(*stream);
 
     codec.reset(avcodec_alloc_context3(decoder));
@@ -364,13 +373,16 @@ struct VideoSource::Impl {
   }
 
   void prepare_converter(const AVFrame& decoded, AVPixelFormat& source_format, int& colorspace, bool& full_range) {
-    full_range = decoded.color_range == AVCOL_RANGE_JPEG ||
-                 (decoded.color_range == AVCOL_RANGE_UNSPECIFIED && info.range == ColorRange::full);
-    source_format = without_jpeg_range(static_cast<AVPixelFormat>(decoded.format), full_range);
+    const auto decoded_format = static_cast<AVPixelFormat>(decoded.format);
+    // The frame's own tag (H.264 VUI) wins; an untagged frame inherits the container's.
+    const AVColorRange range =
+        decoded.color_range != AVCOL_RANGE_UNSPECIFIED ? decoded.color_range : stream->codecpar->color_range;
+    full_range = is_full_range(decoded_format, range);
+    bool jpeg = false;
+    source_format = without_jpeg_range(decoded_format, jpeg);
     bool tagged = false;
     ColorMatrix matrix = matrix_from_av(decoded.colorspace, tagged);
     if (!tagged) matrix = info.matrix_tagged ? info.matrix : default_matrix_for_height(decoded.height);
-    if (!is_yuv_or_gray(source_format)) full_range = true;
     colorspace = sws_colorspace_for(matrix);
 
     if (sws && sws_width == decoded.width && sws_height == decoded.height && sws_format == source_format &&

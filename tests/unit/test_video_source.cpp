@@ -176,6 +176,19 @@ TEST_F(VideoSourceTest, HonoursLimitedAndFullRange) {
   EXPECT_LT(max_error(*limited.next_frame(), kBt709), kColourTolerance);
 }
 
+TEST_F(VideoSourceTest, UntaggedGreyIsFullRange) {
+  // Untagged grey is what stills and depth maps use, full range; reading it as video range would brighten
+  // 200 to 214.
+  VideoSource grey(
+      make_media(
+          dir / "grey.mkv",
+          "-f lavfi -i nullsrc=s=64x36:r=10 -frames:v 1 -vf format=gray,geq=lum=200 -c:v ffv1 -color_range unknown")
+          .string());
+  EXPECT_EQ(grey.info().range, ColorRange::full);
+  const VideoFrame frame = *grey.next_frame();
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(frame.channel(10, 10, c), 200.0 / 255.0, 1.0 / 255.0) << c;
+}
+
 TEST_F(VideoSourceTest, TenBitSourceKeepsMoreThanEightBitsOfPrecision) {
   // A luma ramp over the whole 10-bit limited range, one code value per column (876 steps).
   const auto path = make_media(dir / "ramp10.mkv",
