@@ -4,7 +4,8 @@
 //
 // Colour: the stream's matrix (BT.601/709/2020) and range are honoured; an untagged matrix is
 // BT.709 from 720 rows up, BT.601 below (what players do). Sources deeper than 8 bits are delivered
-// as 16 bits per channel so that their precision survives until the final output.
+// as 16 bits per channel so that their precision survives until the final output (FFmpeg 5.1's
+// swscale maps their peak white to 65283, not 65535: 0.4% short, under one 8-bit step).
 // Rotation: the display matrix (phones recording in portrait) is applied while converting, so every
 // delivered frame is upright; VideoInfo says which rotation was applied.
 #include <cstdint>
