@@ -423,7 +423,11 @@ struct VideoSource::Impl {
     prepare_converter(decoded, source_format, colorspace, full_range);
     if (const int writable = av_frame_make_writable(converted.get()); writable < 0)
       fail(fmt::format("cannot write a converted frame: {}", error_string(writable)));
-    sws_scale(sws.get(), decoded.data, decoded.linesize, 0, decoded.height, converted->data, converted->linesize);
+    if (const int rows = sws_scale(sws.get(), decoded.data, decoded.linesize, 0, decoded.height, converted->data,
+                                   converted->linesize);
+        rows != decoded.height)
+      fail(fmt::format("cannot convert a {}x{} frame to RGBA: {}", decoded.width, decoded.height,
+                       rows < 0 ? error_string(rows) : std::string("incomplete output")));
 
     VideoFrame out;
     const int rotation = info.rotation_degrees;
