@@ -23,5 +23,6 @@ using CommandRegistrar = void (*)(CLI::App& app);
 void add_profiles_command(CLI::App& app);
 void add_design_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
+void add_probe_command(CLI::App& app);
 
 }  // namespace nelf::app

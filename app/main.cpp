@@ -12,6 +12,7 @@ constexpr nelf::app::CommandRegistrar registrars[] = {
     nelf::app::add_profiles_command,
     nelf::app::add_design_command,
     nelf::app::add_convert_command,
+    nelf::app::add_probe_command,
 };
 
 }  // namespace

@@ -1,0 +1,528 @@
+#include "inputs/video_source.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <string_view>
+
+#include "inputs/ffmpeg_raii.hpp"
+
+extern "C" {
+#include <libavutil/display.h>
+#include <libavutil/imgutils.h>
+#include <libavutil/pixdesc.h>
+}
+
+namespace nelf {
+
+std::string_view to_string(ColorMatrix matrix) {
+  switch (matrix) {
+    case ColorMatrix::bt601:
+      return "bt601";
+    case ColorMatrix::bt709:
+      return "bt709";
+    case ColorMatrix::bt2020:
+      return "bt2020";
+    case ColorMatrix::smpte240m:
+      return "smpte240m";
+    case ColorMatrix::fcc:
+      return "fcc";
+    case ColorMatrix::rgb:
+      return "rgb";
+  }
+  return "unknown";
+}
+
+std::string_view to_string(ColorRange range) { return range == ColorRange::full ? "full" : "limited"; }
+
+const void* VideoFrame::pixels() const {
+  return bits > 8 ? static_cast<const void*>(rgba16.data()) : static_cast<const void*>(rgba8.data());
+}
+
+float VideoFrame::channel(int x, int y, int c) const {
+  const std::size_t i =
+      (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 4 +
+      static_cast<std::size_t>(c);
+  return bits > 8 ? static_cast<float>(rgba16[i]) / 65535.f : static_cast<float>(rgba8[i]) / 255.f;
+}
+
+Image VideoFrame::to_image() const {
+  Image image(width, height);
+  float* out = image.data();
+  const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 4;
+  if (bits > 8) {
+    for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(rgba16[i]) / 65535.f;
+  } else {
+    for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<float>(rgba8[i]) / 255.f;
+  }
+  return image;
+}
+
+namespace {
+
+using namespace nelf::ffmpeg;
+
+bool is_url(const std::string& path) { return path.find("://") != std::string::npos || path.rfind("pipe:", 0) == 0; }
+
+double rational_or_zero(AVRational r) { return r.num > 0 && r.den > 0 ? av_q2d(r) : 0.0; }
+
+// Clockwise rotation a player must apply, from the stream's display matrix, snapped to a quarter
+// turn (the same reading as ffmpeg's autorotate: the matrix's angle is counter-clockwise).
+int rotation_from_display_matrix(const AVStream& stream) {
+  size_t size = 0;
+  const uint8_t* data = av_stream_get_side_data(&stream, AV_PKT_DATA_DISPLAYMATRIX, &size);
+  if (data == nullptr || size < 9 * sizeof(int32_t)) return 0;
+  int32_t matrix[9];
+  std::memcpy(matrix, data, sizeof matrix);
+  const double counter_clockwise = av_display_rotation_get(matrix);
+  if (std::isnan(counter_clockwise)) return 0;
+  const long quarter_turns = std::lround(-counter_clockwise / 90.0);
+  return static_cast<int>(((quarter_turns % 4) + 4) % 4) * 90;
+}
+
+ColorMatrix matrix_from_av(AVColorSpace space, bool& tagged) {
+  tagged = true;
+  switch (space) {
+    case AVCOL_SPC_BT709:
+      return ColorMatrix::bt709;
+    case AVCOL_SPC_BT470BG:
+    case AVCOL_SPC_SMPTE170M:
+      return ColorMatrix::bt601;
+    case AVCOL_SPC_BT2020_NCL:
+    case AVCOL_SPC_BT2020_CL:
+      return ColorMatrix::bt2020;
+    case AVCOL_SPC_SMPTE240M:
+      return ColorMatrix::smpte240m;
+    case AVCOL_SPC_FCC:
+      return ColorMatrix::fcc;
+    case AVCOL_SPC_RGB:
+      return ColorMatrix::rgb;
+    default:
+      tagged = false;
+      return ColorMatrix::bt709;
+  }
+}
+
+// Untagged content: HD and up is BT.709, SD is BT.601 — what broadcast and players assume.
+ColorMatrix default_matrix_for_height(int height) { return height >= 720 ? ColorMatrix::bt709 : ColorMatrix::bt601; }
+
+int sws_colorspace_for(ColorMatrix matrix) {
+  switch (matrix) {
+    case ColorMatrix::bt601:
+      return SWS_CS_ITU601;
+    case ColorMatrix::bt709:
+      return SWS_CS_ITU709;
+    case ColorMatrix::bt2020:
+      return SWS_CS_BT2020;
+    case ColorMatrix::smpte240m:
+      return SWS_CS_SMPTE240M;
+    case ColorMatrix::fcc:
+      return SWS_CS_FCC;
+    case ColorMatrix::rgb:
+      break;
+  }
+  return SWS_CS_DEFAULT;
+}
+
+// The deprecated "J" formats mean full-range YUV; swscale wants the plain format plus the range.
+AVPixelFormat without_jpeg_range(AVPixelFormat format, bool& full_range) {
+  switch (format) {
+    case AV_PIX_FMT_YUVJ420P:
+      full_range = true;
+      return AV_PIX_FMT_YUV420P;
+    case AV_PIX_FMT_YUVJ422P:
+      full_range = true;
+      return AV_PIX_FMT_YUV422P;
+    case AV_PIX_FMT_YUVJ444P:
+      full_range = true;
+      return AV_PIX_FMT_YUV444P;
+    case AV_PIX_FMT_YUVJ440P:
+      full_range = true;
+      return AV_PIX_FMT_YUV440P;
+    case AV_PIX_FMT_YUVJ411P:
+      full_range = true;
+      return AV_PIX_FMT_YUV411P;
+    default:
+      return format;
+  }
+}
+
+bool is_yuv_or_gray(AVPixelFormat format) {
+  const AVPixFmtDescriptor* desc = av_pix_fmt_desc_get(format);
+  return desc != nullptr && (desc->flags & AV_PIX_FMT_FLAG_RGB) == 0 && (desc->flags & AV_PIX_FMT_FLAG_PAL) == 0;
+}
+
+// Whether samples in `format` tagged `range` use the full code range. Untagged YUV is limited
+// (video); untagged grey is full (stills, as swscale assumes); RGB and palettes are always full.
+bool is_full_range(AVPixelFormat format, AVColorRange range) {
+  bool jpeg = false;
+  without_jpeg_range(format, jpeg);
+  if (jpeg || !is_yuv_or_gray(format)) return true;
+  const AVPixFmtDescriptor* desc = av_pix_fmt_desc_get(format);
+  const bool gray = desc != nullptr && desc->nb_components <= 2;
+  if (gray) return range != AVCOL_RANGE_MPEG;
+  return range == AVCOL_RANGE_JPEG;
+}
+
+int bits_of(AVPixelFormat format) {
+  const AVPixFmtDescriptor* desc = av_pix_fmt_desc_get(format);
+  return desc != nullptr && desc->nb_components > 0 ? desc->comp[0].depth : 8;
+}
+
+// Copies a tightly packed RGBA image from `src` rows into `dst`, rotated clockwise by `degrees`.
+template <typename Channel>
+void copy_rotated(const uint8_t* src, int src_stride_bytes, int width, int height, int degrees,
+                  std::vector<Channel>& dst) {
+  dst.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 4);
+  const int out_width = (degrees == 90 || degrees == 270) ? height : width;
+  for (int y = 0; y < height; ++y) {
+    const auto* row = reinterpret_cast<const Channel*>(src + static_cast<std::ptrdiff_t>(y) * src_stride_bytes);
+    if (degrees == 0) {
+      std::copy(row, row + static_cast<std::ptrdiff_t>(width) * 4,
+                dst.begin() + static_cast<std::ptrdiff_t>(y) * width * 4);
+      continue;
+    }
+    for (int x = 0; x < width; ++x) {
+      int out_x = x, out_y = y;
+      if (degrees == 90) {
+        out_x = height - 1 - y;
+        out_y = x;
+      } else if (degrees == 180) {
+        out_x = width - 1 - x;
+        out_y = height - 1 - y;
+      } else {  // 270
+        out_x = y;
+        out_y = width - 1 - x;
+      }
+      const std::size_t o =
+          (static_cast<std::size_t>(out_y) * static_cast<std::size_t>(out_width) + static_cast<std::size_t>(out_x)) * 4;
+      std::copy(row + x * 4, row + x * 4 + 4, dst.begin() + static_cast<std::ptrdiff_t>(o));
+    }
+  }
+}
+
+}  // namespace
+
+struct VideoSource::Impl {
+  VideoInfo info;
+  VideoSourceOptions options;
+  FormatContextPtr format;
+  CodecContextPtr codec;
+  AVStream* stream = nullptr;
+  PacketPtr packet;
+  FramePtr frame;
+  FramePtr converted;
+  SwsContextPtr sws;
+  // What `sws` was built for; a change mid-stream (resolution switch) rebuilds it.
+  int sws_width = 0, sws_height = 0, sws_format = -1, sws_colorspace = -1, sws_full_range = -1;
+  bool draining = false;
+  bool finished = false;
+  int consecutive_errors = 0;
+  double last_pts_s = 0.0;
+  std::int64_t frames_out = 0;
+  DecodeStats stats;
+  std::optional<StereoMetadata> frame_stereo;
+
+  [[noreturn]] void fail(const std::string& what) const { throw VideoError(fmt::format("{}: {}", info.path, what)); }
+
+  void open(const std::string& path) {
+    info.path = path;
+    std::string url = path;
+    if (!is_url(path)) {
+      std::error_code ec;
+      const auto status = std::filesystem::status(path, ec);
+      if (!std::filesystem::exists(status)) fail("no such file");
+      if (std::filesystem::is_directory(status)) fail("is a directory, not a media file");
+      // "file:" keeps a colon in a local name from being read as a protocol.
+      url = "file:" + path;
+    }
+
+    AVDictionary* raw_options = nullptr;
+    // Playlists (HLS, concat, …) can otherwise make FFmpeg fetch URLs (DESIGN.md §11).
+    if (!options.allow_network) av_dict_set(&raw_options, "protocol_whitelist", "file,pipe", 0);
+    AVFormatContext* raw_format = nullptr;
+    const int opened = avformat_open_input(&raw_format, url.c_str(), nullptr, &raw_options);
+    DictionaryPtr unused_options(raw_options);
+    if (opened < 0) {
+      if (opened == AVERROR_INVALIDDATA) fail("not a media file FFmpeg can read");
+      if (opened == AVERROR(EACCES)) fail("permission denied");
+      if (!options.allow_network && is_url(path) && path.rfind("pipe:", 0) != 0)
+        fail(fmt::format("cannot open ({}); network access needs --allow-network", error_string(opened)));
+      fail(fmt::format("cannot open: {}", error_string(opened)));
+    }
+    format.reset(raw_format);
+    info.container = format->iformat->name;
+    // FFmpeg opens any text file as "tty" (ANSI art) video; a text file is never meant as content.
+    if (info.container == "tty") fail("not a media file (it looks like text)");
+
+    if (const int found = avformat_find_stream_info(format.get(), nullptr); found < 0)
+      fail(fmt::format("not a readable media file: {}", error_string(found)));
+
+    for (unsigned i = 0; i < format->nb_streams; ++i)
+      if (format->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_AUDIO) ++info.audio_streams;
+
+    const AVCodec* decoder = nullptr;
+    int best = av_find_best_stream(format.get(), AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
+    // Cover art (an audio file's picture) is a "video" stream of one frame: never the content.
+    auto is_moving_video = [](const AVStream* candidate) {
+      return candidate->codecpar->codec_type == AVMEDIA_TYPE_VIDEO &&
+             (candidate->disposition & AV_DISPOSITION_ATTACHED_PIC) == 0;
+    };
+    if (best >= 0 && !is_moving_video(format->streams[best])) {
+      best = AVERROR_STREAM_NOT_FOUND;
+      decoder = nullptr;
+      for (unsigned i = 0; i < format->nb_streams && decoder == nullptr; ++i) {
+        if (!is_moving_video(format->streams[i])) continue;
+        decoder = avcodec_find_decoder(format->streams[i]->codecpar->codec_id);
+        best = decoder != nullptr ? static_cast<int>(i) : AVERROR_DECODER_NOT_FOUND;
+      }
+    }
+    if (best == AVERROR_STREAM_NOT_FOUND) {
+      bool has_cover = false;
+      for (unsigned i = 0; i < format->nb_streams; ++i)
+        if ((format->streams[i]->disposition & AV_DISPOSITION_ATTACHED_PIC) != 0) has_cover = true;
+      std::string only;
+      if (info.audio_streams > 0)
+        only = fmt::format("{} audio stream{}", info.audio_streams, info.audio_streams == 1 ? "" : "s");
+      if (has_cover) only += only.empty() ? "a cover picture" : " and a cover picture";
+      fail(only.empty() ? std::string("no video stream") : fmt::format("no video stream (only {})", only));
+    }
+    if (best == AVERROR_DECODER_NOT_FOUND) {
+      const AVStream* first_video = nullptr;
+      for (unsigned i = 0; i < format->nb_streams && first_video == nullptr; ++i)
+        if (is_moving_video(format->streams[i])) first_video = format->streams[i];
+      const AVCodecID id = first_video != nullptr ? first_video->codecpar->codec_id : AV_CODEC_ID_NONE;
+      if (id == AV_CODEC_ID_NONE) fail("unsupported video codec: FFmpeg does not know the stream's codec");
+      fail(fmt::format("unsupported video codec '{}' (no decoder for it in this FFmpeg build)", avcodec_get_name(id)));
+    }
+    if (best < 0) fail(fmt::format("cannot select a video stream: {}", error_string(best)));
+    stream = format->streams[best];
+    info.stream_index = best;
+    const AVCodecParameters& par = *stream->codecpar;
+    info.video_codec = avcodec_get_name(par.codec_id);
+
+    if (par.width <= 0 || par.height <= 0 || par.width > kMaxVideoDimension || par.height > kMaxVideoDimension)
+      fail(fmt::format("absurd frame size {}x{} (must be 1 to {} pixels each way)", par.width, par.height,
+                       kMaxVideoDimension));
+    info.coded_width = par.width;
+    info.coded_height = par.height;
+    const AVRational sar = av_guess_sample_aspect_ratio(format.get(), stream, nullptr);
+    if (sar.num > 0 && sar.den > 0) {
+      info.sar_num = sar.num;
+      info.sar_den = sar.den;
+    }
+    info.rotation_degrees = options.apply_rotation ? rotation_from_display_matrix(*stream) : 0;
+    const bool quarter_turn = info.rotation_degrees == 90 || info.rotation_degrees == 270;
+    info.width = quarter_turn ? par.height : par.width;
+    info.height = quarter_turn ? par.width : par.height;
+    const double coded_aspect = static_cast<double>(par.width) * info.sar_num / info.sar_den / par.height;
+    info.display_aspect = quarter_turn ? 1.0 / coded_aspect : coded_aspect;
+
+    info.fps = rational_or_zero(stream->avg_frame_rate);
+    if (info.fps == 0.0) info.fps = rational_or_zero(stream->r_frame_rate);
+    if (stream->duration != AV_NOPTS_VALUE && stream->duration > 0)
+      info.duration_s = static_cast<double>(stream->duration) * av_q2d(stream->time_base);
+    else if (format->duration != AV_NOPTS_VALUE && format->duration > 0)
+      info.duration_s = static_cast<double>(format->duration) / AV_TIME_BASE;
+    if (stream->start_time != AV_NOPTS_VALUE)
+      info.start_time_s = static_cast<double>(stream->start_time) * av_q2d(stream->time_base);
+    if (stream->nb_frames > 0) info.frame_count = stream->nb_frames;
+
+    const auto pixel_format = static_cast<AVPixelFormat>(par.format);
+    if (const char* name = av_get_pix_fmt_name(pixel_format)) info.pixel_format = name;
+    info.bits_per_component = bits_of(pixel_format);
+    info.matrix = matrix_from_av(par.color_space, info.matrix_tagged);
+    if (!info.matrix_tagged) info.matrix = default_matrix_for_height(par.height);
+    if (!is_yuv_or_gray(pixel_format) && pixel_format != AV_PIX_FMT_NONE) {
+      info.matrix = ColorMatrix::rgb;
+      info.matrix_tagged = true;
+    }
+    info.range = is_full_range(pixel_format, par.color_range) ? ColorRange::full : ColorRange::limited;
+    info.stream_stereo = stereo_metadata_from_stream(*stream);
+
+    codec.reset(avcodec_alloc_context3(decoder));
+    if (!codec) fail("out of memory allocating the decoder");
+    if (const int copied = avcodec_parameters_to_context(codec.get(), &par); copied < 0)
+      fail(fmt::format("cannot set up the {} decoder: {}", info.video_codec, error_string(copied)));
+    codec->pkt_timebase = stream->time_base;
+    codec->thread_count = 0;  // one per core
+    codec->thread_type = FF_THREAD_FRAME | FF_THREAD_SLICE;
+    if (const int codec_opened = avcodec_open2(codec.get(), decoder, nullptr); codec_opened < 0)
+      fail(fmt::format("cannot open the {} decoder: {}", info.video_codec, error_string(codec_opened)));
+
+    packet.reset(av_packet_alloc());
+    frame.reset(av_frame_alloc());
+    converted.reset(av_frame_alloc());
+    if (!packet || !frame || !converted) fail("out of memory");
+  }
+
+  // Frames the container promised but that never arrived (a truncated file). With an index
+  // (nb_frames) the count is exact; from duration × rate it is an estimate, so a one-frame
+  // difference from rounding is not reported.
+  void count_missing_frames() {
+    if (info.frame_count) {
+      stats.missing_frames = std::max<std::int64_t>(0, *info.frame_count - stats.frames_decoded);
+    } else if (info.duration_s && info.fps > 0.0) {
+      const auto expected = static_cast<std::int64_t>(std::llround(*info.duration_s * info.fps));
+      const std::int64_t shortfall = expected - stats.frames_decoded;
+      stats.missing_frames = shortfall > 1 ? shortfall : 0;
+    }
+  }
+
+  void prepare_converter(const AVFrame& decoded, AVPixelFormat& source_format, int& colorspace, bool& full_range) {
+    const auto decoded_format = static_cast<AVPixelFormat>(decoded.format);
+    // The frame's own tag (H.264 VUI) wins; an untagged frame inherits the container's.
+    const AVColorRange range =
+        decoded.color_range != AVCOL_RANGE_UNSPECIFIED ? decoded.color_range : stream->codecpar->color_range;
+    full_range = is_full_range(decoded_format, range);
+    bool jpeg = false;
+    source_format = without_jpeg_range(decoded_format, jpeg);
+    bool tagged = false;
+    ColorMatrix matrix = matrix_from_av(decoded.colorspace, tagged);
+    if (!tagged) matrix = info.matrix_tagged ? info.matrix : default_matrix_for_height(decoded.height);
+    colorspace = sws_colorspace_for(matrix);
+
+    if (sws && sws_width == decoded.width && sws_height == decoded.height && sws_format == source_format &&
+        sws_colorspace == colorspace && sws_full_range == static_cast<int>(full_range))
+      return;
+    const AVPixelFormat target = bits_of(source_format) > 8 ? AV_PIX_FMT_RGBA64 : AV_PIX_FMT_RGBA;
+    // Full chroma interpolation and accurate rounding: no scaling happens, so quality is cheap.
+    sws.reset(sws_getContext(decoded.width, decoded.height, source_format, decoded.width, decoded.height, target,
+                             SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT | SWS_FULL_CHR_H_INP, nullptr, nullptr,
+                             nullptr));
+    if (!sws)
+      fail(fmt::format("cannot convert pixel format {} to RGBA",
+                       av_get_pix_fmt_name(source_format) ? av_get_pix_fmt_name(source_format) : "unknown"));
+    const int* coefficients = sws_getCoefficients(colorspace);
+    // Output RGB is always full range; brightness 0, contrast and saturation 1.0 (16.16 fixed point).
+    sws_setColorspaceDetails(sws.get(), coefficients, full_range ? 1 : 0, coefficients, 1, 0, 1 << 16, 1 << 16);
+    sws_width = decoded.width;
+    sws_height = decoded.height;
+    sws_format = source_format;
+    sws_colorspace = colorspace;
+    sws_full_range = full_range ? 1 : 0;
+
+    av_frame_unref(converted.get());
+    converted->format = target;
+    converted->width = decoded.width;
+    converted->height = decoded.height;
+    if (const int allocated = av_frame_get_buffer(converted.get(), 0); allocated < 0)
+      fail(fmt::format("cannot allocate a {}x{} frame: {}", decoded.width, decoded.height, error_string(allocated)));
+  }
+
+  VideoFrame convert(AVFrame& decoded) {
+    if (decoded.width <= 0 || decoded.height <= 0 || decoded.width > kMaxVideoDimension ||
+        decoded.height > kMaxVideoDimension)
+      fail(fmt::format("absurd frame size {}x{} in the stream", decoded.width, decoded.height));
+    AVPixelFormat source_format = AV_PIX_FMT_NONE;
+    int colorspace = 0;
+    bool full_range = false;
+    prepare_converter(decoded, source_format, colorspace, full_range);
+    if (const int writable = av_frame_make_writable(converted.get()); writable < 0)
+      fail(fmt::format("cannot write a converted frame: {}", error_string(writable)));
+    if (const int rows = sws_scale(sws.get(), decoded.data, decoded.linesize, 0, decoded.height, converted->data,
+                                   converted->linesize);
+        rows != decoded.height)
+      fail(fmt::format("cannot convert a {}x{} frame to RGBA: {}", decoded.width, decoded.height,
+                       rows < 0 ? error_string(rows) : std::string("incomplete output")));
+
+    VideoFrame out;
+    const int rotation = info.rotation_degrees;
+    const bool quarter_turn = rotation == 90 || rotation == 270;
+    out.width = quarter_turn ? decoded.height : decoded.width;
+    out.height = quarter_turn ? decoded.width : decoded.height;
+    out.bits = converted->format == AV_PIX_FMT_RGBA64 ? 16 : 8;
+    if (out.bits == 16)
+      copy_rotated(converted->data[0], converted->linesize[0], decoded.width, decoded.height, rotation, out.rgba16);
+    else
+      copy_rotated(converted->data[0], converted->linesize[0], decoded.width, decoded.height, rotation, out.rgba8);
+
+    AVRational sar = av_guess_sample_aspect_ratio(format.get(), stream, &decoded);
+    if (sar.num <= 0 || sar.den <= 0) sar = AVRational{1, 1};
+    const double coded_aspect = static_cast<double>(decoded.width) * av_q2d(sar) / decoded.height;
+    out.display_aspect = quarter_turn ? 1.0 / coded_aspect : coded_aspect;
+
+    if (decoded.best_effort_timestamp != AV_NOPTS_VALUE)
+      out.pts_s = static_cast<double>(decoded.best_effort_timestamp) * av_q2d(stream->time_base);
+    else  // no timestamp at all: continue at the nominal rate
+      out.pts_s = frames_out == 0 ? info.start_time_s : last_pts_s + (info.fps > 0.0 ? 1.0 / info.fps : 0.0);
+    last_pts_s = out.pts_s;
+    out.key_frame = decoded.key_frame != 0;
+    out.stereo = stereo_metadata_from_frame(decoded);
+    if (out.stereo) frame_stereo = out.stereo;
+    ++frames_out;
+    return out;
+  }
+
+  std::optional<VideoFrame> next_frame() {
+    if (finished) return std::nullopt;
+    for (;;) {
+      const int received = avcodec_receive_frame(codec.get(), frame.get());
+      if (received == 0) {
+        consecutive_errors = 0;
+        ++stats.frames_decoded;
+        if ((frame->flags & AV_FRAME_FLAG_CORRUPT) != 0 || frame->decode_error_flags != 0) ++stats.decode_errors;
+        VideoFrame out = convert(*frame);
+        av_frame_unref(frame.get());
+        return out;
+      }
+      if (received == AVERROR_EOF) {
+        finished = true;
+        count_missing_frames();
+        return std::nullopt;
+      }
+      if (received != AVERROR(EAGAIN)) {
+        ++stats.decode_errors;
+        // A decoder that fails on every call would otherwise spin forever on a hostile file.
+        if (++consecutive_errors > 1000) fail(fmt::format("the decoder keeps failing: {}", error_string(received)));
+        continue;
+      }
+      if (draining) {  // nothing more can come out
+        finished = true;
+        count_missing_frames();
+        return std::nullopt;
+      }
+      const int read = av_read_frame(format.get(), packet.get());
+      if (read < 0) {
+        if (read != AVERROR_EOF) ++stats.read_errors;
+        draining = true;
+        avcodec_send_packet(codec.get(), nullptr);
+        continue;
+      }
+      if (packet->stream_index == info.stream_index) {
+        if ((packet->flags & AV_PKT_FLAG_CORRUPT) != 0) ++stats.decode_errors;
+        const int sent = avcodec_send_packet(codec.get(), packet.get());
+        if (sent < 0 && sent != AVERROR(EAGAIN)) {
+          ++stats.decode_errors;
+          if (++consecutive_errors > 1000) fail(fmt::format("the decoder keeps failing: {}", error_string(sent)));
+        }
+      }
+      av_packet_unref(packet.get());
+    }
+  }
+};
+
+VideoSource::VideoSource(const std::string& path, VideoSourceOptions options) : impl_(std::make_unique<Impl>()) {
+  impl_->options = options;
+  impl_->open(path);
+}
+
+VideoSource::~VideoSource() = default;
+VideoSource::VideoSource(VideoSource&&) noexcept = default;
+VideoSource& VideoSource::operator=(VideoSource&&) noexcept = default;
+
+const VideoInfo& VideoSource::info() const { return impl_->info; }
+std::optional<VideoFrame> VideoSource::next_frame() { return impl_->next_frame(); }
+const DecodeStats& VideoSource::stats() const { return impl_->stats; }
+
+std::optional<StereoMetadata> VideoSource::stereo_metadata() const {
+  return impl_->info.stream_stereo ? impl_->info.stream_stereo : impl_->frame_stereo;
+}
+std::optional<StereoMetadata> VideoSource::frame_stereo_metadata() const { return impl_->frame_stereo; }
+
+void quiet_ffmpeg_logs(bool quiet) { av_log_set_level(quiet ? AV_LOG_QUIET : AV_LOG_INFO); }
+
+}  // namespace nelf

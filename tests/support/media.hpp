@@ -1,0 +1,31 @@
+#pragma once
+// Test media generated at test time by the ffmpeg CLI (DESIGN.md §9: never committed as blobs).
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+#include "support/test_support.hpp"
+
+namespace nelf::test {
+
+// Runs `ffmpeg ARGS OUTPUT` quietly, overwriting OUTPUT; throws with ffmpeg's own message on failure
+// so that a broken generator shows up as such and not as a decoder bug. lavfi sources are endless:
+// ARGS must bound them (-frames:v, d=, -shortest); the timeout catches a forgotten bound.
+inline std::filesystem::path make_media(const std::filesystem::path& output, const std::string& args) {
+  const CommandResult result = run_command("timeout 60 ffmpeg -nostdin -hide_banner -loglevel error -y " + args + " " +
+                                           shell_quote(output.string()));
+  if (result.status != 0 || !std::filesystem::exists(output))
+    throw std::runtime_error("ffmpeg could not generate " + output.string() + ": " + result.err);
+  return output;
+}
+
+// Two flat colours side by side (left red, right blue) or stacked (top red, bottom blue), each
+// W×H, as lavfi input arguments for make_media.
+inline std::string two_colour_input(int eye_width, int eye_height, bool stacked, int frames = 10, int rate = 10) {
+  const std::string size = std::to_string(eye_width) + "x" + std::to_string(eye_height);
+  return "-f lavfi -i color=c=red:s=" + size + ":r=" + std::to_string(rate) + " -f lavfi -i color=c=blue:s=" + size +
+         ":r=" + std::to_string(rate) + " -filter_complex " + (stacked ? "vstack" : "hstack") + " -frames:v " +
+         std::to_string(frames);
+}
+
+}  // namespace nelf::test
