@@ -2,14 +2,17 @@
 
 #include <fmt/format.h>
 #include <unistd.h>
+#include <functional>
 #include <stdexcept>
 #include <system_error>
 
 extern "C" {
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
+#include <libavutil/audio_fifo.h>
 #include <libavutil/opt.h>
 #include <libavutil/pixdesc.h>
+#include <libswresample/swresample.h>
 #include <libswscale/swscale.h>
 }
 
@@ -31,6 +34,12 @@ struct FrameDeleter {
 };
 struct PacketDeleter {
   void operator()(AVPacket* p) const { av_packet_free(&p); }
+};
+struct SwrDeleter {
+  void operator()(SwrContext* s) const { swr_free(&s); }
+};
+struct FifoDeleter {
+  void operator()(AVAudioFifo* f) const { av_audio_fifo_free(f); }
 };
 struct SwsDeleter {
   void operator()(SwsContext* s) const { sws_freeContext(s); }
@@ -84,6 +93,117 @@ std::filesystem::path temporary_path_for(const std::filesystem::path& output) {
          fmt::format(".{}.nelf-{}{}", output.stem().string(), ::getpid(), output.extension().string());
 }
 
+// An AAC track fed with samples of any format: they are converted (swresample) to the encoder's
+// planar float, queued, and encoded in the encoder's frame size.
+class AudioTrack {
+ public:
+  AudioTrack(AVFormatContext* muxer, int sample_rate, const AVChannelLayout& layout) {
+    const AVCodec* codec = avcodec_find_encoder(AV_CODEC_ID_AAC);
+    if (!codec) throw std::runtime_error("this FFmpeg has no AAC encoder");
+    encoder_.reset(avcodec_alloc_context3(codec));
+    encoder_->sample_rate = sample_rate;
+    encoder_->sample_fmt = AV_SAMPLE_FMT_FLTP;
+    // The encoder wants a native layout even when the source only says "N channels".
+    av_channel_layout_default(&encoder_->ch_layout, layout.nb_channels);
+    encoder_->bit_rate = 96000 * layout.nb_channels;
+    encoder_->time_base = {1, sample_rate};
+    if (muxer->oformat->flags & AVFMT_GLOBALHEADER) encoder_->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
+    if (const int r = avcodec_open2(encoder_.get(), codec, nullptr); r < 0)
+      throw std::runtime_error(fmt::format("cannot open the AAC encoder: {}", av_error(r)));
+    stream_ = avformat_new_stream(muxer, nullptr);
+    avcodec_parameters_from_context(stream_->codecpar, encoder_.get());
+    stream_->time_base = encoder_->time_base;
+    fifo_.reset(av_audio_fifo_alloc(AV_SAMPLE_FMT_FLTP, layout.nb_channels, 4096));
+    frame_.reset(av_frame_alloc());
+    if (!fifo_ || !frame_) throw std::bad_alloc();
+  }
+
+  AVStream* stream() const { return stream_; }
+
+  // Queues samples described by (format, layout, rate); converts them to the encoder's format.
+  void push(const uint8_t* const* data, int count, AVSampleFormat format, const AVChannelLayout& layout, int rate,
+            const std::function<void(AVPacket*)>& write) {
+    if (!resampler_ || format != in_format_ || rate != in_rate_) {
+      SwrContext* raw = nullptr;
+      AVChannelLayout in_layout{};  // FFmpeg 5.1 takes a non-const layout
+      av_channel_layout_copy(&in_layout, &layout);
+      const int set = swr_alloc_set_opts2(&raw, &encoder_->ch_layout, AV_SAMPLE_FMT_FLTP, encoder_->sample_rate,
+                                          &in_layout, format, rate, 0, nullptr);
+      av_channel_layout_uninit(&in_layout);
+      if (set < 0 || swr_init(raw) < 0) {
+        swr_free(&raw);
+        throw std::runtime_error("cannot set up the audio conversion");
+      }
+      resampler_.reset(raw);
+      in_format_ = format;
+      in_rate_ = rate;
+    }
+    const int capacity = static_cast<int>(swr_get_out_samples(resampler_.get(), count));
+    std::vector<std::vector<float>> planes(static_cast<std::size_t>(encoder_->ch_layout.nb_channels),
+                                           std::vector<float>(static_cast<std::size_t>(std::max(capacity, 1))));
+    std::vector<uint8_t*> out;
+    for (auto& p : planes) out.push_back(reinterpret_cast<uint8_t*>(p.data()));
+    const int converted = swr_convert(resampler_.get(), out.data(), capacity, const_cast<const uint8_t**>(data), count);
+    if (converted < 0) throw std::runtime_error("audio conversion failed");
+    av_audio_fifo_write(fifo_.get(), reinterpret_cast<void**>(out.data()), converted);
+    encode_available(false, write);
+  }
+
+  void flush(const std::function<void(AVPacket*)>& write) {
+    encode_available(true, write);
+    drain(true, write);
+  }
+
+ private:
+  void encode_available(bool final_block, const std::function<void(AVPacket*)>& write) {
+    const int frame_size = encoder_->frame_size > 0 ? encoder_->frame_size : 1024;
+    while (av_audio_fifo_size(fifo_.get()) >= frame_size || (final_block && av_audio_fifo_size(fifo_.get()) > 0)) {
+      const int n = std::min(frame_size, av_audio_fifo_size(fifo_.get()));
+      av_frame_unref(frame_.get());
+      frame_->nb_samples = n;
+      frame_->format = AV_SAMPLE_FMT_FLTP;
+      frame_->sample_rate = encoder_->sample_rate;
+      av_channel_layout_copy(&frame_->ch_layout, &encoder_->ch_layout);
+      if (av_frame_get_buffer(frame_.get(), 0) < 0) throw std::bad_alloc();
+      av_audio_fifo_read(fifo_.get(), reinterpret_cast<void**>(frame_->data), n);
+      frame_->pts = next_pts_;
+      next_pts_ += n;
+      if (const int r = avcodec_send_frame(encoder_.get(), frame_.get()); r < 0)
+        throw std::runtime_error(fmt::format("audio encoding failed: {}", av_error(r)));
+      drain(false, write);
+    }
+  }
+
+  void drain(bool flush, const std::function<void(AVPacket*)>& write) {
+    if (flush) avcodec_send_frame(encoder_.get(), nullptr);
+    std::unique_ptr<AVPacket, PacketDeleter> packet(av_packet_alloc());
+    for (;;) {
+      const int r = avcodec_receive_packet(encoder_.get(), packet.get());
+      if (r == AVERROR(EAGAIN) || r == AVERROR_EOF) return;
+      if (r < 0) throw std::runtime_error(fmt::format("audio encoding failed: {}", av_error(r)));
+      av_packet_rescale_ts(packet.get(), encoder_->time_base, stream_->time_base);
+      packet->stream_index = stream_->index;
+      write(packet.get());
+    }
+  }
+
+  std::unique_ptr<AVCodecContext, CodecContextDeleter> encoder_;
+  std::unique_ptr<AVAudioFifo, FifoDeleter> fifo_;
+  std::unique_ptr<SwrContext, SwrDeleter> resampler_;
+  std::unique_ptr<AVFrame, FrameDeleter> frame_;
+  AVStream* stream_ = nullptr;
+  AVSampleFormat in_format_ = AV_SAMPLE_FMT_NONE;
+  int in_rate_ = 0;
+  int64_t next_pts_ = 0;
+};
+
+// A source audio stream the container cannot hold as it is: decoded and re-encoded as AAC.
+struct ReencodedStream {
+  std::unique_ptr<AVCodecContext, CodecContextDeleter> decoder;
+  std::unique_ptr<AVFrame, FrameDeleter> frame{av_frame_alloc()};
+  std::unique_ptr<AudioTrack> track;
+};
+
 }  // namespace
 
 struct VideoEncoder::State {
@@ -99,6 +219,10 @@ struct VideoEncoder::State {
   std::vector<AVRational> source_time_bases;
   std::string codec_name, pixel_format_name;
   bool header_written = false, finished = false;
+  std::unique_ptr<AudioTrack> generated_audio;  // add_audio_track()
+  int generated_channels = 0, generated_rate = 0;
+  std::vector<std::unique_ptr<ReencodedStream>> reencoded;  // by source stream index, null when copied/dropped
+  std::function<void(AVPacket*)> writer = [this](AVPacket* p) { write(p); };
   int64_t last_pts = AV_NOPTS_VALUE;
 
   void drain(bool flush) {
@@ -113,7 +237,17 @@ struct VideoEncoder::State {
     }
   }
 
+  // The header goes out with the first packet, so that tracks can still be added after construction.
+  void ensure_header() {
+    if (header_written) return;
+    if (const int r = avformat_write_header(muxer.get(), nullptr); r < 0)
+      throw std::runtime_error(
+          fmt::format("{}: cannot start the {} file: {}", output.string(), muxer->oformat->name, av_error(r)));
+    header_written = true;
+  }
+
   void write(AVPacket* p) {
+    ensure_header();
     const int r = av_interleaved_write_frame(muxer.get(), p);
     if (r < 0)
       throw std::runtime_error(fmt::format("{}: cannot write: {}", output.string(),
@@ -192,6 +326,25 @@ VideoEncoder::VideoEncoder(const std::filesystem::path& output, int width, int h
       if (type == AVMEDIA_TYPE_AUDIO && !settings.audio) continue;
       if (type != AVMEDIA_TYPE_AUDIO && type != AVMEDIA_TYPE_SUBTITLE) continue;
       if (avformat_query_codec(format, in->codecpar->codec_id, FF_COMPLIANCE_NORMAL) != 1) {
+        if (type == AVMEDIA_TYPE_AUDIO) {
+          // The container cannot hold this audio codec: decode it and re-encode it as AAC.
+          s.reencoded.resize(source->nb_streams);
+          auto re = std::make_unique<ReencodedStream>();
+          const AVCodec* decoder = avcodec_find_decoder(in->codecpar->codec_id);
+          if (decoder) {
+            re->decoder.reset(avcodec_alloc_context3(decoder));
+            avcodec_parameters_to_context(re->decoder.get(), in->codecpar);
+            re->decoder->pkt_timebase = in->time_base;
+          }
+          if (decoder && avcodec_open2(re->decoder.get(), decoder, nullptr) >= 0) {
+            re->track = std::make_unique<AudioTrack>(s.muxer.get(), re->decoder->sample_rate, re->decoder->ch_layout);
+            av_dict_copy(&re->track->stream()->metadata, in->metadata, 0);
+            re->track->stream()->disposition = in->disposition;
+            s.stream_map[i] = re->track->stream()->index;
+            s.reencoded[i] = std::move(re);
+            continue;
+          }
+        }
         fmt::print(stderr, "nelf: warning: {} stream {} ({}) cannot be stored in {}: dropped (use .mkv to keep it)\n",
                    av_get_media_type_string(type), i, avcodec_get_name(in->codecpar->codec_id), format->name);
         continue;
@@ -223,10 +376,6 @@ VideoEncoder::VideoEncoder(const std::filesystem::path& output, int width, int h
     if (const int r = avio_open(&s.muxer->pb, s.temporary.c_str(), AVIO_FLAG_WRITE); r < 0)
       throw std::runtime_error(fmt::format("{}: cannot write here: {}", output.string(), av_error(r)));
   }
-  if (const int r = avformat_write_header(s.muxer.get(), nullptr); r < 0)
-    throw std::runtime_error(
-        fmt::format("{}: cannot start the {} file: {}", output.string(), format->name, av_error(r)));
-  s.header_written = true;
 
   s.frame.reset(av_frame_alloc());
   s.frame->format = c.pix_fmt;
@@ -283,6 +432,17 @@ void VideoEncoder::write_source_packet(AVPacket* packet, int source_stream) {
   if (source_stream < 0 || source_stream >= static_cast<int>(s.stream_map.size())) return;
   const int out_index = s.stream_map[static_cast<std::size_t>(source_stream)];
   if (out_index < 0) return;
+  if (static_cast<std::size_t>(source_stream) < s.reencoded.size() &&
+      s.reencoded[static_cast<std::size_t>(source_stream)]) {
+    ReencodedStream& re = *s.reencoded[static_cast<std::size_t>(source_stream)];
+    if (avcodec_send_packet(re.decoder.get(), packet) < 0) return;  // a damaged audio packet is skipped
+    while (avcodec_receive_frame(re.decoder.get(), re.frame.get()) >= 0) {
+      re.track->push(re.frame->extended_data, re.frame->nb_samples, static_cast<AVSampleFormat>(re.frame->format),
+                     re.frame->ch_layout, re.frame->sample_rate, s.writer);
+      av_frame_unref(re.frame.get());
+    }
+    return;
+  }
   av_packet_rescale_ts(packet, s.source_time_bases[static_cast<std::size_t>(source_stream)],
                        s.muxer->streams[out_index]->time_base);
   packet->stream_index = out_index;
@@ -290,9 +450,32 @@ void VideoEncoder::write_source_packet(AVPacket* packet, int source_stream) {
   s.write(packet);
 }
 
+void VideoEncoder::add_audio_track(int sample_rate, int channels) {
+  State& s = *state_;
+  if (s.header_written) throw std::logic_error("VideoEncoder::add_audio_track after the header was written");
+  AVChannelLayout layout;
+  av_channel_layout_default(&layout, channels);
+  s.generated_audio = std::make_unique<AudioTrack>(s.muxer.get(), sample_rate, layout);
+  s.generated_channels = channels;
+  s.generated_rate = sample_rate;
+}
+
+void VideoEncoder::write_audio(const float* interleaved, int sample_count) {
+  State& s = *state_;
+  if (!s.generated_audio) throw std::logic_error("VideoEncoder::write_audio without add_audio_track");
+  const uint8_t* data[1] = {reinterpret_cast<const uint8_t*>(interleaved)};
+  AVChannelLayout layout;
+  av_channel_layout_default(&layout, s.generated_channels);
+  s.generated_audio->push(data, sample_count, AV_SAMPLE_FMT_FLT, layout, s.generated_rate, s.writer);
+}
+
 void VideoEncoder::finish() {
   State& s = *state_;
+  s.ensure_header();
   s.drain(true);
+  if (s.generated_audio) s.generated_audio->flush(s.writer);
+  for (auto& re : s.reencoded)
+    if (re) re->track->flush(s.writer);
   if (const int r = av_write_trailer(s.muxer.get()); r < 0)
     throw std::runtime_error(fmt::format("{}: cannot finish the file: {}", s.output.string(), av_error(r)));
   if (s.muxer->pb) {

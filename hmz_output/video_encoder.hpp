@@ -46,6 +46,11 @@ class VideoEncoder {
   void write_video(const PackedFrame& frame);
   // A packet of source stream `source_stream` (audio/subtitle); ignored when that stream is not carried.
   void write_source_packet(AVPacket* packet, int source_stream);
+  // A generated audio track (e.g. the synthetic source's tone), encoded as AAC. Call before the first
+  // write; then pass interleaved float samples (−1..1) in order.
+  void add_audio_track(int sample_rate, int channels);
+  void write_audio(const float* interleaved, int sample_count);
+
   // Flushes, writes the trailer and renames the temporary file to the output path.
   void finish();
 

@@ -200,3 +200,58 @@ TEST(VideoEncoder, CarriesAudioSubtitlesAndChapters) {
 
 }  // namespace
 }  // namespace nelf
+
+namespace nelf {
+namespace {
+
+TEST(VideoEncoder, GeneratedAudioTrackIsAac) {
+  test::TempDir dir;
+  const auto out = dir / "tone.mp4";
+  VideoEncoder enc(out, 64, 64, 25, 1, EncoderSettings{});
+  enc.add_audio_track(48000, 1);
+  std::vector<float> second(48000);
+  for (std::size_t i = 0; i < second.size(); ++i) second[i] = 0.3f * static_cast<float>(std::sin(i * 0.0576));
+  for (int i = 0; i < 25; ++i) {
+    enc.write_video(test_frame(64, 64, i / 25.0, 0, 0));
+    enc.write_audio(second.data() + i * 1920, 1920);
+  }
+  enc.finish();
+  const auto r =
+      test::run_command("ffprobe -v error -show_entries stream=codec_name,sample_rate,channels -of csv=p=0 " +
+                        test::shell_quote(out.string()));
+  EXPECT_NE(r.out.find("aac,48000,1"), std::string::npos) << r.out;
+}
+
+// PCM cannot go into MP4 as it is: it is re-encoded as AAC rather than lost.
+TEST(VideoEncoder, ReencodesAudioTheContainerCannotHold) {
+  test::TempDir dir;
+  const auto source_path = dir / "pcm.mkv";
+  ASSERT_EQ(test::run_command("ffmpeg -v error -f lavfi -i testsrc2=size=64x36:rate=10 -f lavfi -i "
+                              "sine=frequency=440:sample_rate=44100 -t 1 -c:v libx264 -c:a pcm_s16le " +
+                              test::shell_quote(source_path.string()))
+                .status,
+            0);
+  AVFormatContext* raw = nullptr;
+  ASSERT_EQ(avformat_open_input(&raw, source_path.c_str(), nullptr, nullptr), 0);
+  std::unique_ptr<AVFormatContext, InputCloser> source(raw);
+  ASSERT_GE(avformat_find_stream_info(source.get(), nullptr), 0);
+  const auto out = dir / "out.mp4";
+  VideoEncoder enc(out, 64, 36, 10, 1, EncoderSettings{}, source.get());
+  AVPacket* packet = av_packet_alloc();
+  int frame_index = 0;
+  while (av_read_frame(source.get(), packet) >= 0) {
+    if (packet->stream_index == 0)
+      enc.write_video(test_frame(64, 36, frame_index++ / 10.0, 0, 0));
+    else
+      enc.write_source_packet(packet, packet->stream_index);
+    av_packet_unref(packet);
+  }
+  av_packet_free(&packet);
+  enc.finish();
+  const auto r = test::run_command("ffprobe -v error -show_entries stream=codec_name,sample_rate -of csv=p=0 " +
+                                   test::shell_quote(out.string()));
+  EXPECT_NE(r.out.find("aac,44100"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace nelf
