@@ -1,0 +1,503 @@
+#include "hmz_output/video_encoder.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+#include <functional>
+#include <stdexcept>
+#include <system_error>
+
+extern "C" {
+#include <libavcodec/avcodec.h>
+#include <libavformat/avformat.h>
+#include <libavutil/audio_fifo.h>
+#include <libavutil/opt.h>
+#include <libavutil/pixdesc.h>
+#include <libswresample/swresample.h>
+#include <libswscale/swscale.h>
+}
+
+namespace nelf {
+
+namespace {
+
+std::string av_error(int code) {
+  char buffer[AV_ERROR_MAX_STRING_SIZE] = {};
+  av_strerror(code, buffer, sizeof buffer);
+  return buffer;
+}
+
+struct CodecContextDeleter {
+  void operator()(AVCodecContext* c) const { avcodec_free_context(&c); }
+};
+struct FrameDeleter {
+  void operator()(AVFrame* f) const { av_frame_free(&f); }
+};
+struct PacketDeleter {
+  void operator()(AVPacket* p) const { av_packet_free(&p); }
+};
+struct SwrDeleter {
+  void operator()(SwrContext* s) const { swr_free(&s); }
+};
+struct FifoDeleter {
+  void operator()(AVAudioFifo* f) const { av_audio_fifo_free(f); }
+};
+struct SwsDeleter {
+  void operator()(SwsContext* s) const { sws_freeContext(s); }
+};
+// An output context owns its AVIOContext only once avio_open succeeded.
+struct OutputContextDeleter {
+  void operator()(AVFormatContext* f) const {
+    if (f->pb && !(f->oformat->flags & AVFMT_NOFILE)) avio_closep(&f->pb);
+    avformat_free_context(f);
+  }
+};
+
+// The encoder behind a user-facing codec name.
+const AVCodec* find_encoder(const std::string& name) {
+  const char* actual = name == "h264" ? "libx264" : name == "hevc" || name == "h265" ? "libx265" : name.c_str();
+  const AVCodec* codec = avcodec_find_encoder_by_name(actual);
+  if (!codec || codec->type != AVMEDIA_TYPE_VIDEO)
+    throw std::invalid_argument(
+        fmt::format("--codec {}: no such video encoder in this FFmpeg (try h264, hevc, ffv1)", name));
+  return codec;
+}
+
+// The pixel format to encode in, in order of preference. Lossless codecs keep RGB planes exactly.
+// 4:2:0 needs even dimensions (libx264 refuses 4:2:0 at 2205 rows), so odd sizes use 4:4:4.
+// Sources deeper than 8 bits keep 10 bits where the encoder can.
+AVPixelFormat choose_pixel_format(const AVCodec* codec, int width, int height, int bits) {
+  const bool even = width % 2 == 0 && height % 2 == 0;
+  const bool deep = bits > 8;
+  std::vector<AVPixelFormat> wanted;
+  if (codec->id == AV_CODEC_ID_FFV1) {
+    if (deep) wanted.insert(wanted.end(), {AV_PIX_FMT_GBRP10, AV_PIX_FMT_GBRP16});
+    wanted.insert(wanted.end(), {AV_PIX_FMT_BGR0, AV_PIX_FMT_GBRP});
+  }
+  if (deep && even) wanted.push_back(AV_PIX_FMT_YUV420P10);
+  if (deep) wanted.push_back(AV_PIX_FMT_YUV444P10);
+  if (even) wanted.push_back(AV_PIX_FMT_YUV420P);
+  wanted.insert(wanted.end(), {AV_PIX_FMT_YUV444P, AV_PIX_FMT_GBRP, AV_PIX_FMT_RGB24, AV_PIX_FMT_BGR0});
+  if (!codec->pix_fmts) return wanted.front();
+  for (AVPixelFormat w : wanted)
+    for (const AVPixelFormat* p = codec->pix_fmts; *p != AV_PIX_FMT_NONE; ++p)
+      if (*p == w) return w;
+  throw std::invalid_argument(
+      fmt::format("--codec {}: no pixel format usable for a {}x{} frame", codec->name, width, height));
+}
+
+bool is_rgb(AVPixelFormat f) { return av_pix_fmt_desc_get(f)->flags & AV_PIX_FMT_FLAG_RGB; }
+
+std::filesystem::path temporary_path_for(const std::filesystem::path& output) {
+  // Same directory (so the final rename is atomic), same extension (so the muxer is the same).
+  return output.parent_path() /
+         fmt::format(".{}.nelf-{}{}", output.stem().string(), ::getpid(), output.extension().string());
+}
+
+// An AAC track fed with samples of any format: they are converted (swresample) to the encoder's
+// planar float, queued, and encoded in the encoder's frame size.
+class AudioTrack {
+ public:
+  AudioTrack(AVFormatContext* muxer, int sample_rate, const AVChannelLayout& layout) {
+    const AVCodec* codec = avcodec_find_encoder(AV_CODEC_ID_AAC);
+    if (!codec) throw std::runtime_error("this FFmpeg has no AAC encoder");
+    encoder_.reset(avcodec_alloc_context3(codec));
+    encoder_->sample_rate = sample_rate;
+    encoder_->sample_fmt = AV_SAMPLE_FMT_FLTP;
+    // The encoder wants a native layout even when the source only says "N channels".
+    av_channel_layout_default(&encoder_->ch_layout, layout.nb_channels);
+    encoder_->bit_rate = 96000 * layout.nb_channels;
+    encoder_->time_base = {1, sample_rate};
+    if (muxer->oformat->flags & AVFMT_GLOBALHEADER) encoder_->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
+    if (const int r = avcodec_open2(encoder_.get(), codec, nullptr); r < 0)
+      throw std::runtime_error(fmt::format("cannot open the AAC encoder: {}", av_error(r)));
+    stream_ = avformat_new_stream(muxer, nullptr);
+    avcodec_parameters_from_context(stream_->codecpar, encoder_.get());
+    stream_->time_base = encoder_->time_base;
+    fifo_.reset(av_audio_fifo_alloc(AV_SAMPLE_FMT_FLTP, layout.nb_channels, 4096));
+    frame_.reset(av_frame_alloc());
+    if (!fifo_ || !frame_) throw std::bad_alloc();
+  }
+
+  AVStream* stream() const { return stream_; }
+
+  // Queues samples described by (format, layout, rate); converts them to the encoder's format.
+  void push(const uint8_t* const* data, int count, AVSampleFormat format, const AVChannelLayout& layout, int rate,
+            const std::function<void(AVPacket*)>& write) {
+    if (!resampler_ || format != in_format_ || rate != in_rate_) {
+      SwrContext* raw = nullptr;
+      AVChannelLayout in_layout{};  // FFmpeg 5.1 takes a non-const layout
+      av_channel_layout_copy(&in_layout, &layout);
+      const int set = swr_alloc_set_opts2(&raw, &encoder_->ch_layout, AV_SAMPLE_FMT_FLTP, encoder_->sample_rate,
+                                          &in_layout, format, rate, 0, nullptr);
+      av_channel_layout_uninit(&in_layout);
+      if (set < 0 || swr_init(raw) < 0) {
+        swr_free(&raw);
+        throw std::runtime_error("cannot set up the audio conversion");
+      }
+      resampler_.reset(raw);
+      in_format_ = format;
+      in_rate_ = rate;
+    }
+    const int capacity = static_cast<int>(swr_get_out_samples(resampler_.get(), count));
+    std::vector<std::vector<float>> planes(static_cast<std::size_t>(encoder_->ch_layout.nb_channels),
+                                           std::vector<float>(static_cast<std::size_t>(std::max(capacity, 1))));
+    std::vector<uint8_t*> out;
+    for (auto& p : planes) out.push_back(reinterpret_cast<uint8_t*>(p.data()));
+    const int converted = swr_convert(resampler_.get(), out.data(), capacity, const_cast<const uint8_t**>(data), count);
+    if (converted < 0) throw std::runtime_error("audio conversion failed");
+    av_audio_fifo_write(fifo_.get(), reinterpret_cast<void**>(out.data()), converted);
+    encode_available(false, write);
+  }
+
+  void flush(const std::function<void(AVPacket*)>& write) {
+    encode_available(true, write);
+    drain(true, write);
+  }
+
+ private:
+  void encode_available(bool final_block, const std::function<void(AVPacket*)>& write) {
+    const int frame_size = encoder_->frame_size > 0 ? encoder_->frame_size : 1024;
+    while (av_audio_fifo_size(fifo_.get()) >= frame_size || (final_block && av_audio_fifo_size(fifo_.get()) > 0)) {
+      const int n = std::min(frame_size, av_audio_fifo_size(fifo_.get()));
+      av_frame_unref(frame_.get());
+      frame_->nb_samples = n;
+      frame_->format = AV_SAMPLE_FMT_FLTP;
+      frame_->sample_rate = encoder_->sample_rate;
+      av_channel_layout_copy(&frame_->ch_layout, &encoder_->ch_layout);
+      if (av_frame_get_buffer(frame_.get(), 0) < 0) throw std::bad_alloc();
+      av_audio_fifo_read(fifo_.get(), reinterpret_cast<void**>(frame_->data), n);
+      frame_->pts = next_pts_;
+      next_pts_ += n;
+      if (const int r = avcodec_send_frame(encoder_.get(), frame_.get()); r < 0)
+        throw std::runtime_error(fmt::format("audio encoding failed: {}", av_error(r)));
+      drain(false, write);
+    }
+  }
+
+  void drain(bool flush, const std::function<void(AVPacket*)>& write) {
+    if (flush) avcodec_send_frame(encoder_.get(), nullptr);
+    std::unique_ptr<AVPacket, PacketDeleter> packet(av_packet_alloc());
+    for (;;) {
+      const int r = avcodec_receive_packet(encoder_.get(), packet.get());
+      if (r == AVERROR(EAGAIN) || r == AVERROR_EOF) return;
+      if (r < 0) throw std::runtime_error(fmt::format("audio encoding failed: {}", av_error(r)));
+      av_packet_rescale_ts(packet.get(), encoder_->time_base, stream_->time_base);
+      packet->stream_index = stream_->index;
+      write(packet.get());
+    }
+  }
+
+  std::unique_ptr<AVCodecContext, CodecContextDeleter> encoder_;
+  std::unique_ptr<AVAudioFifo, FifoDeleter> fifo_;
+  std::unique_ptr<SwrContext, SwrDeleter> resampler_;
+  std::unique_ptr<AVFrame, FrameDeleter> frame_;
+  AVStream* stream_ = nullptr;
+  AVSampleFormat in_format_ = AV_SAMPLE_FMT_NONE;
+  int in_rate_ = 0;
+  int64_t next_pts_ = 0;
+};
+
+// A source audio stream the container cannot hold as it is: decoded and re-encoded as AAC.
+struct ReencodedStream {
+  std::unique_ptr<AVCodecContext, CodecContextDeleter> decoder;
+  std::unique_ptr<AVFrame, FrameDeleter> frame{av_frame_alloc()};
+  std::unique_ptr<AudioTrack> track;
+};
+
+}  // namespace
+
+struct VideoEncoder::State {
+  std::filesystem::path output, temporary;
+  std::unique_ptr<AVFormatContext, OutputContextDeleter> muxer;
+  std::unique_ptr<AVCodecContext, CodecContextDeleter> encoder;
+  std::unique_ptr<AVFrame, FrameDeleter> frame;
+  std::unique_ptr<AVPacket, PacketDeleter> packet{av_packet_alloc()};
+  std::unique_ptr<SwsContext, SwsDeleter> sws;
+  int sws_bits = 0;
+  AVStream* video_stream = nullptr;
+  std::vector<int> stream_map;  // source stream index -> output stream index, -1 when dropped
+  std::vector<AVRational> source_time_bases;
+  std::string codec_name, pixel_format_name;
+  bool header_written = false, finished = false;
+  std::unique_ptr<AudioTrack> generated_audio;  // add_audio_track()
+  int generated_channels = 0, generated_rate = 0;
+  std::vector<std::unique_ptr<ReencodedStream>> reencoded;  // by source stream index, null when copied/dropped
+  std::function<void(AVPacket*)> writer = [this](AVPacket* p) { write(p); };
+  int64_t last_pts = AV_NOPTS_VALUE;
+
+  void drain(bool flush) {
+    if (flush) avcodec_send_frame(encoder.get(), nullptr);
+    for (;;) {
+      const int r = avcodec_receive_packet(encoder.get(), packet.get());
+      if (r == AVERROR(EAGAIN) || r == AVERROR_EOF) return;
+      if (r < 0) throw std::runtime_error(fmt::format("{}: encoding failed: {}", output.string(), av_error(r)));
+      av_packet_rescale_ts(packet.get(), encoder->time_base, video_stream->time_base);
+      packet->stream_index = video_stream->index;
+      write(packet.get());
+    }
+  }
+
+  // The header goes out with the first packet, so that tracks can still be added after construction.
+  void ensure_header() {
+    if (header_written) return;
+    if (const int r = avformat_write_header(muxer.get(), nullptr); r < 0)
+      throw std::runtime_error(
+          fmt::format("{}: cannot start the {} file: {}", output.string(), muxer->oformat->name, av_error(r)));
+    header_written = true;
+  }
+
+  void write(AVPacket* p) {
+    ensure_header();
+    const int r = av_interleaved_write_frame(muxer.get(), p);
+    if (r < 0)
+      throw std::runtime_error(fmt::format("{}: cannot write: {}", output.string(),
+                                           r == AVERROR(ENOSPC) ? "no space left on device" : av_error(r)));
+  }
+};
+
+VideoEncoder::VideoEncoder(const std::filesystem::path& output, int width, int height, int frame_rate_num,
+                           int frame_rate_den, const EncoderSettings& settings, AVFormatContext* source)
+    : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.output = output;
+  std::error_code ec;
+  if (std::filesystem::exists(output, ec) && !settings.overwrite)
+    throw std::runtime_error(fmt::format("{}: already exists; pass -y to overwrite", output.string()));
+  const AVOutputFormat* format = av_guess_format(nullptr, output.filename().c_str(), nullptr);
+  if (!format)
+    throw std::invalid_argument(
+        fmt::format("{}: unknown output format; use an extension such as .mkv, .mp4 or .mov", output.string()));
+  const AVCodec* codec = find_encoder(settings.codec);
+  if (avformat_query_codec(format, codec->id, FF_COMPLIANCE_NORMAL) != 1)
+    throw std::invalid_argument(fmt::format("{}: the {} container cannot hold {} video (use .mkv)", output.string(),
+                                            format->name, codec->name));
+
+  s.temporary = temporary_path_for(output);
+  AVFormatContext* raw = nullptr;
+  if (avformat_alloc_output_context2(&raw, format, nullptr, s.temporary.c_str()) < 0 || !raw)
+    throw std::runtime_error(fmt::format("{}: cannot set up the {} muxer", output.string(), format->name));
+  s.muxer.reset(raw);
+
+  // Video encoder.
+  s.encoder.reset(avcodec_alloc_context3(codec));
+  AVCodecContext& c = *s.encoder;
+  c.width = width;
+  c.height = height;
+  c.sample_aspect_ratio = {1, 1};
+  c.framerate = {frame_rate_num, frame_rate_den};
+  c.time_base = {1, 90000};  // fine enough for any frame rate, keeps variable frame timing
+  c.pix_fmt = choose_pixel_format(codec, width, height, settings.bits);
+  c.thread_count = 0;
+  if (is_rgb(c.pix_fmt)) {
+    c.color_range = AVCOL_RANGE_JPEG;
+    c.colorspace = AVCOL_SPC_RGB;
+  } else {
+    c.color_range = AVCOL_RANGE_MPEG;
+    c.colorspace = AVCOL_SPC_BT709;
+  }
+  c.color_primaries = AVCOL_PRI_BT709;
+  c.color_trc = AVCOL_TRC_BT709;
+  if (s.muxer->oformat->flags & AVFMT_GLOBALHEADER) c.flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
+  if (codec->id == AV_CODEC_ID_H264 || codec->id == AV_CODEC_ID_HEVC) {
+    av_opt_set(c.priv_data, "preset", settings.preset.c_str(), 0);
+    av_opt_set_double(c.priv_data, "crf", settings.crf.value_or(18), 0);
+    if (codec->id == AV_CODEC_ID_HEVC) av_opt_set(c.priv_data, "x265-params", "log-level=error", 0);
+  } else if (settings.crf) {
+    throw std::invalid_argument(fmt::format("--crf applies to h264 and hevc, not {}", codec->name));
+  }
+  if (const int r = avcodec_open2(&c, codec, nullptr); r < 0)
+    throw std::runtime_error(fmt::format("{}: cannot open the {} encoder for {}x{}: {}", output.string(), codec->name,
+                                         width, height, av_error(r)));
+  s.codec_name = codec->name;
+  s.pixel_format_name = av_get_pix_fmt_name(c.pix_fmt);
+
+  s.video_stream = avformat_new_stream(s.muxer.get(), nullptr);
+  avcodec_parameters_from_context(s.video_stream->codecpar, &c);
+  s.video_stream->time_base = c.time_base;
+  s.video_stream->avg_frame_rate = c.framerate;
+
+  // Carry the source's audio and subtitle streams, chapters and metadata where the container takes them.
+  if (source) {
+    s.stream_map.assign(source->nb_streams, -1);
+    for (unsigned i = 0; i < source->nb_streams; ++i) {
+      const AVStream* in = source->streams[i];
+      s.source_time_bases.push_back(in->time_base);
+      const AVMediaType type = in->codecpar->codec_type;
+      if (type == AVMEDIA_TYPE_AUDIO && !settings.audio) continue;
+      if (type != AVMEDIA_TYPE_AUDIO && type != AVMEDIA_TYPE_SUBTITLE) continue;
+      if (avformat_query_codec(format, in->codecpar->codec_id, FF_COMPLIANCE_NORMAL) != 1) {
+        if (type == AVMEDIA_TYPE_AUDIO) {
+          // The container cannot hold this audio codec: decode it and re-encode it as AAC.
+          s.reencoded.resize(source->nb_streams);
+          auto re = std::make_unique<ReencodedStream>();
+          const AVCodec* decoder = avcodec_find_decoder(in->codecpar->codec_id);
+          if (decoder) {
+            re->decoder.reset(avcodec_alloc_context3(decoder));
+            avcodec_parameters_to_context(re->decoder.get(), in->codecpar);
+            re->decoder->pkt_timebase = in->time_base;
+          }
+          if (decoder && avcodec_open2(re->decoder.get(), decoder, nullptr) >= 0) {
+            re->track = std::make_unique<AudioTrack>(s.muxer.get(), re->decoder->sample_rate, re->decoder->ch_layout);
+            av_dict_copy(&re->track->stream()->metadata, in->metadata, 0);
+            re->track->stream()->disposition = in->disposition;
+            s.stream_map[i] = re->track->stream()->index;
+            s.reencoded[i] = std::move(re);
+            continue;
+          }
+        }
+        fmt::print(stderr, "nelf: warning: {} stream {} ({}) cannot be stored in {}: dropped (use .mkv to keep it)\n",
+                   av_get_media_type_string(type), i, avcodec_get_name(in->codecpar->codec_id), format->name);
+        continue;
+      }
+      AVStream* out = avformat_new_stream(s.muxer.get(), nullptr);
+      avcodec_parameters_copy(out->codecpar, in->codecpar);
+      out->codecpar->codec_tag = 0;
+      out->time_base = in->time_base;
+      out->disposition = in->disposition;
+      av_dict_copy(&out->metadata, in->metadata, 0);  // language tags, titles
+      s.stream_map[i] = out->index;
+    }
+    av_dict_copy(&s.muxer->metadata, source->metadata, 0);
+    if (source->nb_chapters > 0) {
+      s.muxer->chapters = static_cast<AVChapter**>(av_calloc(source->nb_chapters, sizeof(AVChapter*)));
+      if (!s.muxer->chapters) throw std::bad_alloc();
+      for (unsigned i = 0; i < source->nb_chapters; ++i) {
+        const AVChapter* in = source->chapters[i];
+        auto* out = static_cast<AVChapter*>(av_mallocz(sizeof(AVChapter)));
+        if (!out) throw std::bad_alloc();
+        *out = {in->id, in->time_base, in->start, in->end, nullptr};
+        av_dict_copy(&out->metadata, in->metadata, 0);
+        s.muxer->chapters[s.muxer->nb_chapters++] = out;
+      }
+    }
+  }
+
+  if (!(format->flags & AVFMT_NOFILE)) {
+    if (const int r = avio_open(&s.muxer->pb, s.temporary.c_str(), AVIO_FLAG_WRITE); r < 0)
+      throw std::runtime_error(fmt::format("{}: cannot write here: {}", output.string(), av_error(r)));
+  }
+
+  s.frame.reset(av_frame_alloc());
+  s.frame->format = c.pix_fmt;
+  s.frame->width = width;
+  s.frame->height = height;
+  s.frame->color_range = c.color_range;
+  s.frame->colorspace = c.colorspace;
+  s.frame->color_primaries = c.color_primaries;
+  s.frame->color_trc = c.color_trc;
+  if (av_frame_get_buffer(s.frame.get(), 0) < 0) throw std::bad_alloc();
+}
+
+VideoEncoder::~VideoEncoder() {
+  if (!state_ || state_->finished) return;
+  // Unfinished: close the file and remove it, leaving nothing half-written behind.
+  state_->muxer.reset();
+  std::error_code ec;
+  std::filesystem::remove(state_->temporary, ec);
+}
+
+void VideoEncoder::write_video(const PackedFrame& in) {
+  State& s = *state_;
+  AVCodecContext& c = *s.encoder;
+  if (in.width != c.width || in.height != c.height)
+    throw std::logic_error(
+        fmt::format("VideoEncoder: frame is {}x{}, stream is {}x{}", in.width, in.height, c.width, c.height));
+  if (!s.sws || s.sws_bits != in.bits) {
+    const AVPixelFormat source_format = in.bits > 8 ? AV_PIX_FMT_RGBA64LE : AV_PIX_FMT_RGBA;
+    s.sws.reset(sws_getContext(c.width, c.height, source_format, c.width, c.height, c.pix_fmt,
+                               SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT, nullptr, nullptr, nullptr));
+    if (!s.sws) throw std::runtime_error("cannot set up the RGB to YUV conversion");
+    if (!is_rgb(c.pix_fmt)) {
+      // RGB → BT.709 limited-range YUV: the matrix the stream is tagged with.
+      const int* bt709 = sws_getCoefficients(SWS_CS_ITU709);
+      sws_setColorspaceDetails(s.sws.get(), bt709, 1, bt709, 0, 0, 1 << 16, 1 << 16);
+    }
+    s.sws_bits = in.bits;
+  }
+  if (av_frame_make_writable(s.frame.get()) < 0) throw std::bad_alloc();
+  const uint8_t* planes[1] = {in.rgba.data()};
+  const int strides[1] = {in.width * 4 * (in.bits > 8 ? 2 : 1)};
+  sws_scale(s.sws.get(), planes, strides, 0, in.height, s.frame->data, s.frame->linesize);
+  int64_t pts = llround(in.pts_seconds * c.time_base.den / c.time_base.num);
+  if (s.last_pts != AV_NOPTS_VALUE && pts <= s.last_pts) pts = s.last_pts + 1;  // strictly increasing
+  s.last_pts = pts;
+  s.frame->pts = pts;
+  if (const int r = avcodec_send_frame(&c, s.frame.get()); r < 0)
+    throw std::runtime_error(fmt::format("{}: encoding failed: {}", s.output.string(), av_error(r)));
+  s.drain(false);
+}
+
+void VideoEncoder::write_source_packet(AVPacket* packet, int source_stream) {
+  State& s = *state_;
+  if (source_stream < 0 || source_stream >= static_cast<int>(s.stream_map.size())) return;
+  const int out_index = s.stream_map[static_cast<std::size_t>(source_stream)];
+  if (out_index < 0) return;
+  if (static_cast<std::size_t>(source_stream) < s.reencoded.size() &&
+      s.reencoded[static_cast<std::size_t>(source_stream)]) {
+    ReencodedStream& re = *s.reencoded[static_cast<std::size_t>(source_stream)];
+    if (avcodec_send_packet(re.decoder.get(), packet) < 0) return;  // a damaged audio packet is skipped
+    while (avcodec_receive_frame(re.decoder.get(), re.frame.get()) >= 0) {
+      re.track->push(re.frame->extended_data, re.frame->nb_samples, static_cast<AVSampleFormat>(re.frame->format),
+                     re.frame->ch_layout, re.frame->sample_rate, s.writer);
+      av_frame_unref(re.frame.get());
+    }
+    return;
+  }
+  av_packet_rescale_ts(packet, s.source_time_bases[static_cast<std::size_t>(source_stream)],
+                       s.muxer->streams[out_index]->time_base);
+  packet->stream_index = out_index;
+  packet->pos = -1;
+  s.write(packet);
+}
+
+void VideoEncoder::add_audio_track(int sample_rate, int channels) {
+  State& s = *state_;
+  if (s.header_written) throw std::logic_error("VideoEncoder::add_audio_track after the header was written");
+  AVChannelLayout layout;
+  av_channel_layout_default(&layout, channels);
+  s.generated_audio = std::make_unique<AudioTrack>(s.muxer.get(), sample_rate, layout);
+  s.generated_channels = channels;
+  s.generated_rate = sample_rate;
+}
+
+void VideoEncoder::write_audio(const float* interleaved, int sample_count) {
+  State& s = *state_;
+  if (!s.generated_audio) throw std::logic_error("VideoEncoder::write_audio without add_audio_track");
+  const uint8_t* data[1] = {reinterpret_cast<const uint8_t*>(interleaved)};
+  AVChannelLayout layout;
+  av_channel_layout_default(&layout, s.generated_channels);
+  s.generated_audio->push(data, sample_count, AV_SAMPLE_FMT_FLT, layout, s.generated_rate, s.writer);
+}
+
+void VideoEncoder::finish() {
+  State& s = *state_;
+  s.ensure_header();
+  s.drain(true);
+  if (s.generated_audio) s.generated_audio->flush(s.writer);
+  for (auto& re : s.reencoded)
+    if (re) re->track->flush(s.writer);
+  if (const int r = av_write_trailer(s.muxer.get()); r < 0)
+    throw std::runtime_error(fmt::format("{}: cannot finish the file: {}", s.output.string(), av_error(r)));
+  if (s.muxer->pb) {
+    if (const int r = avio_closep(&s.muxer->pb); r < 0)
+      throw std::runtime_error(fmt::format("{}: cannot write: {}", s.output.string(), av_error(r)));
+  }
+  std::error_code ec;
+  std::filesystem::rename(s.temporary, s.output, ec);
+  if (ec)
+    throw std::runtime_error(
+        fmt::format("{}: cannot rename the finished file into place: {}", s.output.string(), ec.message()));
+  s.finished = true;
+}
+
+const std::string& VideoEncoder::codec_name() const { return state_->codec_name; }
+const std::string& VideoEncoder::pixel_format_name() const { return state_->pixel_format_name; }
+
+std::vector<int> VideoEncoder::carried_streams() const {
+  std::vector<int> carried;
+  for (std::size_t i = 0; i < state_->stream_map.size(); ++i)
+    if (state_->stream_map[i] >= 0) carried.push_back(static_cast<int>(i));
+  return carried;
+}
+
+}  // namespace nelf

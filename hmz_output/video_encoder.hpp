@@ -1,0 +1,67 @@
+#pragma once
+// The encoder sink: packed RGBA frames in, a video file out (FFmpeg), with the source's audio,
+// subtitle and chapter streams carried over where the container takes them. The file is written
+// under a temporary name in the destination directory and renamed by finish(); an encoder that is
+// destroyed unfinished (error, Ctrl-C) removes its temporary file, so no half-written output remains.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+struct AVFormatContext;
+struct AVPacket;
+
+namespace nelf {
+
+struct EncoderSettings {
+  std::string codec = "h264";  // h264, hevc, ffv1, or any FFmpeg encoder name
+  std::optional<int> crf;      // quality for x264/x265 (default 18)
+  std::string preset = "medium";
+  bool overwrite = false;  // -y
+  bool audio = true;       // carry the source's audio streams
+  int bits = 8;            // bit depth to keep: 10-bit sources keep 10 bits where the codec allows
+};
+
+// One frame of the packed signal: 8-bit (bits = 8) or 16-bit (bits = 16) RGBA, rows top to bottom.
+struct PackedFrame {
+  int width = 0;
+  int height = 0;
+  int bits = 8;
+  std::vector<std::uint8_t> rgba;  // width × height × 4 × (bits / 8) bytes
+  double pts_seconds = 0.0;
+};
+
+class VideoEncoder {
+ public:
+  // `source` (optional) is the opened input whose non-video streams are carried over; `frame_rate`
+  // is the nominal rate (num/den) used as the stream's rate; timestamps come from each frame.
+  VideoEncoder(const std::filesystem::path& output, int width, int height, int frame_rate_num, int frame_rate_den,
+               const EncoderSettings& settings, AVFormatContext* source = nullptr);
+  ~VideoEncoder();
+  VideoEncoder(const VideoEncoder&) = delete;
+  VideoEncoder& operator=(const VideoEncoder&) = delete;
+
+  void write_video(const PackedFrame& frame);
+  // A packet of source stream `source_stream` (audio/subtitle); ignored when that stream is not carried.
+  void write_source_packet(AVPacket* packet, int source_stream);
+  // A generated audio track (e.g. the synthetic source's tone), encoded as AAC. Call before the first
+  // write; then pass interleaved float samples (−1..1) in order.
+  void add_audio_track(int sample_rate, int channels);
+  void write_audio(const float* interleaved, int sample_count);
+
+  // Flushes, writes the trailer and renames the temporary file to the output path.
+  void finish();
+
+  const std::string& codec_name() const;
+  const std::string& pixel_format_name() const;
+  // Source streams carried (as source stream indices).
+  std::vector<int> carried_streams() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace nelf
