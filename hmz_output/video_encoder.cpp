@@ -1,5 +1,7 @@
 #include "hmz_output/video_encoder.hpp"
 
+#include "inputs/ffmpeg_raii.hpp"
+
 #include <fmt/format.h>
 #include <unistd.h>
 #include <functional>
@@ -20,29 +22,17 @@ namespace nelf {
 
 namespace {
 
-std::string av_error(int code) {
-  char buffer[AV_ERROR_MAX_STRING_SIZE] = {};
-  av_strerror(code, buffer, sizeof buffer);
-  return buffer;
-}
+using ffmpeg::CodecContextPtr;
+using ffmpeg::FramePtr;
+using ffmpeg::PacketPtr;
+using ffmpeg::SwsContextPtr;
+std::string av_error(int code) { return ffmpeg::error_string(code); }
 
-struct CodecContextDeleter {
-  void operator()(AVCodecContext* c) const { avcodec_free_context(&c); }
-};
-struct FrameDeleter {
-  void operator()(AVFrame* f) const { av_frame_free(&f); }
-};
-struct PacketDeleter {
-  void operator()(AVPacket* p) const { av_packet_free(&p); }
-};
 struct SwrDeleter {
   void operator()(SwrContext* s) const { swr_free(&s); }
 };
 struct FifoDeleter {
   void operator()(AVAudioFifo* f) const { av_audio_fifo_free(f); }
-};
-struct SwsDeleter {
-  void operator()(SwsContext* s) const { sws_freeContext(s); }
 };
 // An output context owns its AVIOContext only once avio_open succeeded.
 struct OutputContextDeleter {
@@ -176,7 +166,7 @@ class AudioTrack {
 
   void drain(bool flush, const std::function<void(AVPacket*)>& write) {
     if (flush) avcodec_send_frame(encoder_.get(), nullptr);
-    std::unique_ptr<AVPacket, PacketDeleter> packet(av_packet_alloc());
+    PacketPtr packet(av_packet_alloc());
     for (;;) {
       const int r = avcodec_receive_packet(encoder_.get(), packet.get());
       if (r == AVERROR(EAGAIN) || r == AVERROR_EOF) return;
@@ -187,10 +177,10 @@ class AudioTrack {
     }
   }
 
-  std::unique_ptr<AVCodecContext, CodecContextDeleter> encoder_;
+  CodecContextPtr encoder_;
   std::unique_ptr<AVAudioFifo, FifoDeleter> fifo_;
   std::unique_ptr<SwrContext, SwrDeleter> resampler_;
-  std::unique_ptr<AVFrame, FrameDeleter> frame_;
+  FramePtr frame_;
   AVStream* stream_ = nullptr;
   AVSampleFormat in_format_ = AV_SAMPLE_FMT_NONE;
   int in_rate_ = 0;
@@ -199,8 +189,8 @@ class AudioTrack {
 
 // A source audio stream the container cannot hold as it is: decoded and re-encoded as AAC.
 struct ReencodedStream {
-  std::unique_ptr<AVCodecContext, CodecContextDeleter> decoder;
-  std::unique_ptr<AVFrame, FrameDeleter> frame{av_frame_alloc()};
+  CodecContextPtr decoder;
+  FramePtr frame{av_frame_alloc()};
   std::unique_ptr<AudioTrack> track;
 };
 
@@ -209,10 +199,10 @@ struct ReencodedStream {
 struct VideoEncoder::State {
   std::filesystem::path output, temporary;
   std::unique_ptr<AVFormatContext, OutputContextDeleter> muxer;
-  std::unique_ptr<AVCodecContext, CodecContextDeleter> encoder;
-  std::unique_ptr<AVFrame, FrameDeleter> frame;
-  std::unique_ptr<AVPacket, PacketDeleter> packet{av_packet_alloc()};
-  std::unique_ptr<SwsContext, SwsDeleter> sws;
+  CodecContextPtr encoder;
+  FramePtr frame;
+  PacketPtr packet{av_packet_alloc()};
+  SwsContextPtr sws;
   int sws_bits = 0;
   AVStream* video_stream = nullptr;
   std::vector<int> stream_map;  // source stream index -> output stream index, -1 when dropped
