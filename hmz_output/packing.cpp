@@ -20,6 +20,22 @@ void blit_centred(Image& frame, const Image& eye, int area_x, int area_y, int ar
 
 }  // namespace
 
+std::optional<EyeArea> eye_area(const Signal& signal, Eye eye, int eye_w, int eye_h) {
+  const bool right = eye == Eye::right;
+  switch (signal.kind) {
+    case SignalKind::hdmi_frame_packing:
+      return EyeArea{0, right ? signal.right_eye_first_row() : 0, signal.eye_width, signal.eye_height};
+    case SignalKind::side_by_side:
+      return EyeArea{right ? eye_w : 0, 0, eye_w, eye_h};
+    case SignalKind::top_bottom:
+      return EyeArea{0, right ? eye_h : 0, eye_w, eye_h};
+    case SignalKind::single_eye:
+      if (signal.eye != eye) return std::nullopt;
+      return EyeArea{0, 0, eye_w, eye_h};
+  }
+  return std::nullopt;
+}
+
 Image pack_eyes(const Signal& signal, const Image& left, const Image& right) {
   if (left.empty() || right.empty()) throw std::invalid_argument("pack_eyes: empty eye image");
   if (left.width() != right.width() || left.height() != right.height())
@@ -27,23 +43,9 @@ Image pack_eyes(const Signal& signal, const Image& left, const Image& right) {
                                             left.height(), right.width(), right.height()));
   const int w = left.width(), h = left.height();
   Image frame(signal.packed_width(w), signal.packed_height(h));  // black, alpha 1
-  switch (signal.kind) {
-    case SignalKind::hdmi_frame_packing:
-      blit_centred(frame, left, 0, 0, signal.eye_width, signal.eye_height);
-      blit_centred(frame, right, 0, signal.right_eye_first_row(), signal.eye_width, signal.eye_height);
-      break;
-    case SignalKind::side_by_side:
-      blit_centred(frame, left, 0, 0, w, h);
-      blit_centred(frame, right, w, 0, w, h);
-      break;
-    case SignalKind::top_bottom:
-      blit_centred(frame, left, 0, 0, w, h);
-      blit_centred(frame, right, 0, h, w, h);
-      break;
-    case SignalKind::single_eye:
-      blit_centred(frame, signal.eye == Eye::left ? left : right, 0, 0, w, h);
-      break;
-  }
+  for (Eye eye : {Eye::left, Eye::right})
+    if (const auto area = eye_area(signal, eye, w, h))
+      blit_centred(frame, eye == Eye::left ? left : right, area->x, area->y, area->width, area->height);
   return frame;
 }
 

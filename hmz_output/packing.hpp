@@ -1,11 +1,20 @@
 #pragma once
 // Packs the compositor's two eye images into the frame of an output signal.
+#include <optional>
 #include <stdexcept>
 
 #include "compositor/compositor.hpp"
 #include "hmz_output/signal.hpp"
 
 namespace nelf {
+
+// Where an eye's image goes in the packed frame of `signal` for eye images of `eye_w` x `eye_h`:
+// the area reserved for it (HDMI: the fixed eye area; otherwise the eye size). nullopt when the
+// signal does not carry that eye (left/right).
+struct EyeArea {
+  int x = 0, y = 0, width = 0, height = 0;
+};
+std::optional<EyeArea> eye_area(const Signal& signal, Eye eye, int eye_w, int eye_h);
 
 // Both eye images must have the same, non-zero size. HDMI frame packing: left eye in rows
 // [0, eye_height), black gap (RGB 0, alpha 1), right eye from row eye_height + gap_rows. When the eye

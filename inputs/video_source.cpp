@@ -225,6 +225,8 @@ struct VideoSource::Impl {
   std::int64_t frames_out = 0;
   DecodeStats stats;
   std::optional<StereoMetadata> frame_stereo;
+  std::optional<double> pending_after_seek;
+  bool seeked = false;  // frames before this time (s) are skipped after seek()
 
   [[noreturn]] void fail(const std::string& what) const { throw VideoError(fmt::format("{}: {}", info.path, what)); }
 
@@ -363,6 +365,7 @@ struct VideoSource::Impl {
   // (nb_frames) the count is exact; from duration × rate it is an estimate, so a one-frame
   // difference from rounding is not reported.
   void count_missing_frames() {
+    if (seeked) return;  // the container's promise counts from the start, which was skipped
     if (info.frame_count) {
       stats.missing_frames = std::max<std::int64_t>(0, *info.frame_count - stats.frames_decoded);
     } else if (info.duration_s && info.fps > 0.0) {
@@ -515,8 +518,32 @@ VideoSource::VideoSource(VideoSource&&) noexcept = default;
 VideoSource& VideoSource::operator=(VideoSource&&) noexcept = default;
 
 const VideoInfo& VideoSource::info() const { return impl_->info; }
-std::optional<VideoFrame> VideoSource::next_frame() { return impl_->next_frame(); }
+std::optional<VideoFrame> VideoSource::next_frame() {
+  for (;;) {
+    auto frame = impl_->next_frame();
+    if (!frame || !impl_->pending_after_seek || frame->pts_s >= *impl_->pending_after_seek) {
+      impl_->pending_after_seek.reset();
+      return frame;
+    }
+  }
+}
 const DecodeStats& VideoSource::stats() const { return impl_->stats; }
+
+void VideoSource::seek(double seconds) {
+  Impl& m = *impl_;
+  if (seconds <= 0.0) return;
+  const double target = m.info.start_time_s + seconds;
+  const auto timestamp = static_cast<std::int64_t>(std::floor(target / av_q2d(m.stream->time_base)));
+  if (av_seek_frame(m.format.get(), m.stream->index, timestamp, AVSEEK_FLAG_BACKWARD) < 0)
+    m.fail(fmt::format("cannot seek to {:.3f} s", seconds));
+  avcodec_flush_buffers(m.codec.get());
+  m.draining = false;
+  m.finished = false;
+  m.consecutive_errors = 0;
+  m.seeked = true;
+  // Decode from the keyframe up to the target; the caller gets the first frame at or after it.
+  m.pending_after_seek = target - 0.5 * (m.info.fps > 0 ? 1.0 / m.info.fps : 0.0);
+}
 
 std::optional<StereoMetadata> VideoSource::stereo_metadata() const {
   return impl_->info.stream_stereo ? impl_->info.stream_stereo : impl_->frame_stereo;

@@ -113,6 +113,11 @@ class VideoSource {
 
   const DecodeStats& stats() const;
 
+  // Positions decoding so that the next frames are those at or after `seconds` (from the start of
+  // the stream): seeks to the keyframe before it and decodes up to it. Throws VideoError when the
+  // file cannot seek.
+  void seek(double seconds);
+
   // The stream's stereo metadata if the container has it, else the last frame-packing SEI seen
   // while decoding (the SEI rides on keyframes only, so it is remembered).
   std::optional<StereoMetadata> stereo_metadata() const;
