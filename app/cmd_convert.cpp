@@ -28,6 +28,7 @@ struct ConvertArgs {
   bool swap_eyes = false;
   std::string signal;  // empty = the profile's output.signal
   int fsaa = 1;
+  std::optional<int> gpu;
   int bits = 8;
   bool overwrite = false;
 };
@@ -66,6 +67,7 @@ ConvertPlan plan_convert(const ConvertArgs& args) {
     throw UserError(e.what(), 2);
   }
   plan.compositor.fsaa = args.fsaa;
+  plan.compositor.gpu = args.gpu;
 
   plan.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
   const std::string signal_name = args.signal.empty() ? plan.profile.signal : args.signal;
@@ -127,6 +129,8 @@ void add_convert_command(CLI::App& app) {
       fmt::format("Output signal: {} (default: the profile's output.signal)", fmt::join(signal_names(), ", ")));
   cmd->add_option("--fsaa", args->fsaa, "Antialiasing: 0 (one tap), 1 (prefilter), 4 or 16 (sub-samples)")
       ->capture_default_str();
+  cmd->add_option("--gpu", args->gpu,
+                  "EGL device index to render on (default: NELF_GPU, else the first GPU, else software)");
   cmd->add_option("--bits", args->bits, "Bits per channel of the output file: 8, or 16 for .png/.tif")
       ->capture_default_str();
   cmd->add_flag("-y,--overwrite", args->overwrite, "Replace the output file if it exists");

@@ -2,6 +2,7 @@
 // The compositor stage: a stereo pair of views in, one image per eye at panel resolution out
 // (DESIGN.md §3–4). Implementations: the OpenGL path (gl_compositor) and the CPU reference.
 #include <array>
+#include <optional>
 
 #include "compositor/image.hpp"
 #include "compositor/profile.hpp"
@@ -12,6 +13,9 @@ struct CompositorOptions {
   // 0: one bilinear tap (comparison only); 1: footprint prefilter (default);
   // 4, 16: prefilter plus N aperture sub-samples per pixel.
   int fsaa = 1;
+  // EGL device index for the GL compositor (`--gpu N`); unset: NELF_GPU, else the first hardware
+  // device, else Mesa's software renderer.
+  std::optional<int> gpu;
 };
 
 // Throws std::invalid_argument naming the allowed values when `fsaa` is not 0, 1, 4 or 16.

@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
     const int levels[] = {0, 1, 4, 16};
     std::vector<std::unique_ptr<nelf::GlCompositor>> compositors;
     for (int fsaa : levels)
-      compositors.push_back(std::make_unique<nelf::GlCompositor>(profile, nelf::CompositorOptions{fsaa}, context));
+      compositors.push_back(std::make_unique<nelf::GlCompositor>(profile, nelf::CompositorOptions{fsaa, std::nullopt}, context));
     std::vector<std::vector<double>> render_ms(4), compose_ms(4);
     for (int run = 0; run <= runs; ++run) {
       for (std::size_t level = 0; level < compositors.size(); ++level) {

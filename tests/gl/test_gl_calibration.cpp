@@ -18,7 +18,7 @@ using test::psnr;
 using test::shared_gl_context;
 
 EyeImages gl_eyes(const Profile& profile, int fsaa, const View& view) {
-  GlCompositor compositor(profile, {fsaa}, shared_gl_context());
+  GlCompositor compositor(profile, {fsaa, std::nullopt}, shared_gl_context());
   return compositor.compose({view, view});
 }
 
@@ -125,7 +125,7 @@ TEST(GlStock, PillarboxAndLetterboxKeepTheAspect) {
 TEST(GlCompositor, RenderEyeIntoAPackedFrameRegion) {
   const Profile profile = load_profile("hmz-t1");
   const View view{test::photo_chart(960, 540), 0.0};
-  GlCompositor compositor(profile, {1}, shared_gl_context());
+  GlCompositor compositor(profile, {1, std::nullopt}, shared_gl_context());
   const EyeImages expected = compositor.compose({view, view});
 
   const gl::Texture source = upload_texture(view.image);

@@ -22,7 +22,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 // One eye through the GL compositor.
 Image gl_eye(const Profile& profile, int fsaa, const View& view, Eye eye = Eye::left) {
-  GlCompositor compositor(profile, {fsaa}, shared_gl_context());
+  GlCompositor compositor(profile, {fsaa, std::nullopt}, shared_gl_context());
   return compositor.compose({view, view})[static_cast<int>(eye)];
 }
 
@@ -53,7 +53,7 @@ TEST(GlContext, SecondContextOnTheSameDeviceLeavesTheFirstWorking) {
     gl::EglContext second;
     EXPECT_EQ(second.renderer(), context->renderer());
   }
-  GlCompositor compositor(test::small_panel_profile(), {0}, context);  // makes the first current again
+  GlCompositor compositor(test::small_panel_profile(), {0, std::nullopt}, context);  // makes the first current again
   Image grey(48, 27);
   for (Rgba& p : grey.pixels()) p = {0.5f, 0.5f, 0.5f, 1.f};
   const Image eye = compositor.compose({{grey, 0.0}, {grey, 0.0}})[0];
@@ -70,7 +70,7 @@ TEST(GlContext, MalformedNelfGpuIsAClearError) {
 
 TEST(GlCompositor, InvalidFsaaIsRejected) {
   try {
-    GlCompositor compositor(load_profile("hmz-t1"), {3}, shared_gl_context());
+    GlCompositor compositor(load_profile("hmz-t1"), {3, std::nullopt}, shared_gl_context());
     FAIL() << "fsaa 3 was accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("0, 1, 4 or 16"), std::string::npos) << e.what();
@@ -78,7 +78,7 @@ TEST(GlCompositor, InvalidFsaaIsRejected) {
 }
 
 TEST(GlCompositor, EmptyViewIsRejected) {
-  GlCompositor compositor(test::small_panel_profile(), {1}, shared_gl_context());
+  GlCompositor compositor(test::small_panel_profile(), {1, std::nullopt}, shared_gl_context());
   EXPECT_THROW(compositor.compose({}), std::invalid_argument);
 }
 
@@ -132,7 +132,7 @@ TEST(GlVsReference, EightBitViewTextureThroughRenderEye) {
   const gl::Texture target = gl::make_texture_2d(GL_RGBA8, 320, 180);
   const gl::Framebuffer fbo = gl::make_framebuffer(target);
   for (int fsaa : {0, 1}) {
-    GlCompositor compositor(profile, {fsaa}, shared_gl_context());
+    GlCompositor compositor(profile, {fsaa, std::nullopt}, shared_gl_context());
     compositor.render_eye(Eye::left, {source.id(), 480, 270, 0.0}, {fbo.id(), 0, 0});
     const double db = psnr(read_back(fbo.id(), 0, 0, 320, 180), reference);
     std::printf("RGBA8 view and target, fsaa %d: %.2f dB\n", fsaa, db);
