@@ -9,7 +9,7 @@
 #include <string>
 
 #include "app/commands.hpp"
-#include "inputs/layout_chain.hpp"
+#include "inputs/stereo_layout.hpp"
 #include "inputs/video_source.hpp"
 
 namespace nelf::app {
@@ -51,14 +51,14 @@ ProbeResult probe(const ProbeOptions& options) {
 
   ProbeResult result{source.info(), source.stereo_metadata(), {}, source.stats()};
   LayoutEvidence evidence;
-  if (!options.layout.empty()) evidence.flag_layout = options.layout;
-  evidence.flag_swap_eyes = options.swap_eyes;
+  if (!options.layout.empty()) evidence.flag = parse_stereo_layout(options.layout);  // checked by CLI11
+  evidence.swap_eyes = options.swap_eyes;
   evidence.metadata = result.metadata;
   evidence.width = result.info.width;
   evidence.height = result.info.height;
   evidence.display_aspect = result.info.display_aspect;
-  evidence.path = options.input;
-  result.decision = decide_layout(evidence);
+  evidence.filename = options.input;
+  result.decision = detect_stereo_layout(evidence);
   return result;
 }
 
@@ -69,7 +69,7 @@ nlohmann::json optional_number(const std::optional<double>& value) {
 void print_json(const ProbeResult& r) {
   const VideoInfo& info = r.info;
   nlohmann::json out = {
-      {"layout", r.decision.layout},
+      {"layout", std::string(to_string(r.decision.layout))},
       {"swap_eyes", r.decision.swap_eyes},
       {"rule", std::string(to_string(r.decision.rule))},
       {"width", info.width},
@@ -111,7 +111,7 @@ void print_summary(const ProbeResult& r) {
   if (r.metadata)
     fmt::print("stereo:    {}{} (file metadata)\n", to_string(r.metadata->packing),
                r.metadata->inverted ? ", right view first" : "");
-  fmt::print("layout:    {}{} (rule: {})\n", r.decision.layout, r.decision.swap_eyes ? ", eyes swapped" : "",
+  fmt::print("layout:    {}{} (rule: {})\n", to_string(r.decision.layout), r.decision.swap_eyes ? ", eyes swapped" : "",
              to_string(r.decision.rule));
 }
 

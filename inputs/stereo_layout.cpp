@@ -42,10 +42,11 @@ double ratio(int w, int h) { return static_cast<double>(w) / static_cast<double>
 
 std::string frame_size(const Image& frame) { return fmt::format("{}x{}", frame.width(), frame.height()); }
 
-// Side-by-side half or full, told apart by the frame's aspect as the aspect rule does: a full SBS
-// frame is at least 3:1 (two 16:9 views are 3.56:1), a full TAB frame at most 1:1.
-bool full_side_by_side(int w, int h) { return h > 0 && ratio(w, h) >= 3.0; }
-bool full_top_bottom(int w, int h) { return h > 0 && ratio(w, h) <= 1.0; }
+// The aspect rule of DESIGN.md §6, used only when nothing else says the frame is stereo: a full
+// SBS frame is at least 3:1 (two 16:9 views are 3.56:1), a full TAB frame at most 1:1. Metadata and
+// `lr`/`rl` tokens, which do say stereo, use the looser half/full thresholds of stereo_metadata.hpp.
+bool aspect_says_full_side_by_side(double aspect) { return aspect >= 3.0; }
+bool aspect_says_full_top_bottom(double aspect) { return aspect > 0.0 && aspect <= 1.0; }
 
 std::string lowercase(std::string_view s) {
   std::string out(s);
@@ -169,7 +170,10 @@ std::string_view to_string(DetectionRule rule) {
   return "unknown";
 }
 
-std::optional<FilenameLayout> layout_from_filename(const std::filesystem::path& filename) {
+std::optional<FilenameLayout> layout_from_filename(const std::filesystem::path& filename, double display_aspect) {
+  // `lr`/`rl` say side-by-side only; half or full as metadata decides it, full when the aspect is unknown.
+  const StereoLayout side_by_side =
+      display_aspect > 0.0 && display_aspect < kFullSideBySideMinAspect ? StereoLayout::sbs_half : StereoLayout::sbs;
   const auto tokens = alphanumeric_tokens(filename.filename().string());
   bool says_3d = false;
   for (std::size_t i = 0; i < tokens.size(); ++i) {
@@ -184,8 +188,8 @@ std::optional<FilenameLayout> layout_from_filename(const std::filesystem::path& 
     if (t == "hsbs") return FilenameLayout{StereoLayout::sbs_half};
     if (t == "tab" || t == "ou" || t == "ftab" || t == "fou") return FilenameLayout{StereoLayout::tab};
     if (t == "htab" || t == "hou") return FilenameLayout{StereoLayout::tab_half};
-    if (t == "lr") return FilenameLayout{StereoLayout::sbs};
-    if (t == "rl") return FilenameLayout{StereoLayout::sbs, true};
+    if (t == "lr") return FilenameLayout{side_by_side};
+    if (t == "rl") return FilenameLayout{side_by_side, true};
     if (t == "3d") says_3d = true;
   }
   // "3D" with nothing more specific: release groups mean half side-by-side by it.
@@ -194,44 +198,32 @@ std::optional<FilenameLayout> layout_from_filename(const std::filesystem::path& 
 }
 
 LayoutDecision detect_stereo_layout(const LayoutEvidence& evidence) {
+  const int w = evidence.width, h = evidence.height;
+  const double aspect = evidence.display_aspect > 0.0 ? evidence.display_aspect : h > 0 ? ratio(w, h) : 0.0;
   LayoutDecision decision = [&]() -> LayoutDecision {
     if (evidence.flag) return {*evidence.flag, false, DetectionRule::flag, {}};
     if (evidence.metadata) {
-      const auto& m = *evidence.metadata;
-      const int w = evidence.width, h = evidence.height;
-      switch (m.arrangement) {
-        case StereoMetadata::Arrangement::side_by_side:
-          return {full_side_by_side(w, h) ? StereoLayout::sbs : StereoLayout::sbs_half,
-                  m.inverted,
-                  DetectionRule::metadata,
-                  {}};
-        case StereoMetadata::Arrangement::top_bottom:
-          return {full_top_bottom(w, h) ? StereoLayout::tab : StereoLayout::tab_half,
-                  m.inverted,
-                  DetectionRule::metadata,
-                  {}};
-        case StereoMetadata::Arrangement::frame_sequential:
-          return {StereoLayout::alt, m.inverted, DetectionRule::metadata, {}};
-        case StereoMetadata::Arrangement::mono:
-          return {StereoLayout::mono, false, DetectionRule::metadata, {}};
-      }
+      // Throws UnsupportedStereoMetadata for packings nelf cannot split.
+      const MetadataLayout m = layout_from_stereo_metadata(*evidence.metadata, aspect);
+      const auto layout = parse_stereo_layout(m.layout);
+      if (!layout) throw std::logic_error("layout_from_stereo_metadata gave an unknown layout " + m.layout);
+      return {*layout, m.swap_eyes, DetectionRule::metadata, {}};
     }
-    if (frame_packed_geometry(evidence.width, evidence.height))
-      return {StereoLayout::fp, false, DetectionRule::frame_size, {}};
-    if (auto named = layout_from_filename(evidence.filename))
+    if (frame_packed_geometry(w, h)) return {StereoLayout::fp, false, DetectionRule::frame_size, {}};
+    if (auto named = layout_from_filename(evidence.filename, aspect))
       return {named->layout, named->swap_eyes, DetectionRule::filename, {}};
     if (is_jps(evidence.filename)) return {StereoLayout::sbs, false, DetectionRule::filename, {}};
-    if (evidence.height > 0 && full_side_by_side(evidence.width, evidence.height))
-      return {StereoLayout::sbs, false, DetectionRule::aspect, {}};
-    if (evidence.height > 0 && full_top_bottom(evidence.width, evidence.height))
-      return {StereoLayout::tab, false, DetectionRule::aspect, {}};
+    if (aspect_says_full_side_by_side(aspect)) return {StereoLayout::sbs, false, DetectionRule::aspect, {}};
+    if (aspect_says_full_top_bottom(aspect)) return {StereoLayout::tab, false, DetectionRule::aspect, {}};
     return {StereoLayout::mono, false, DetectionRule::fallback,
             fmt::format("no stereo layout detected for {} ({}x{}); showing it as 2D to both eyes (pass --layout "
                         "to choose one)",
-                        evidence.filename.filename().string(), evidence.width, evidence.height)};
+                        evidence.filename.filename().string(), w, h)};
   }();
   // JPS stores the right view on the left by definition of the format, whatever decided the layout.
   if (is_jps(evidence.filename)) decision.swap_eyes = !decision.swap_eyes;
+  // --swap-eyes swaps on top of whatever was detected.
+  if (evidence.swap_eyes) decision.swap_eyes = !decision.swap_eyes;
   return decision;
 }
 

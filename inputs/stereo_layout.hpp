@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "compositor/image.hpp"
+#include "inputs/stereo_metadata.hpp"
 
 namespace nelf {
 
@@ -44,25 +45,20 @@ std::optional<FramePackedGeometry> frame_packed_geometry(int width, int height);
 // frame-packed format, an empty frame) or needs two frames (`alt`, `pair`).
 StereoPair split_frame(const Image& frame, StereoLayout layout, bool swap_eyes = false);
 
-// Stereo metadata carried by a container or stream (AVStereo3D and friends). It says how the views
-// are arranged but never whether they are half or full resolution; that is inferred from the aspect.
-struct StereoMetadata {
-  enum class Arrangement { mono, side_by_side, top_bottom, frame_sequential };
-  Arrangement arrangement = Arrangement::mono;
-  bool inverted = false;  // right view first (AV_STEREO3D_FLAG_INVERT)
-};
-
 // Which rule of the detection order decided (`nelf probe` prints it).
 enum class DetectionRule { flag, metadata, frame_size, filename, aspect, fallback };
 // "flag", "metadata", "frame-size", "filename", "aspect", "default".
 std::string_view to_string(DetectionRule rule);
 
+// The first five fields are positional in callers: {flag, metadata, width, height, filename}.
 struct LayoutEvidence {
   std::optional<StereoLayout> flag;        // the user's --layout
-  std::optional<StereoMetadata> metadata;  // from the container or stream, when there is any
-  int width = 0;                           // the full frame's size
+  std::optional<StereoMetadata> metadata;  // stream side data, else a remembered frame-packing SEI
+  int width = 0;                           // the full frame's size as delivered (after rotation)
   int height = 0;
   std::filesystem::path filename;  // only the last component is looked at
+  bool swap_eyes = false;          // the user's --swap-eyes: swaps whatever was detected (XOR)
+  double display_aspect = 0.0;     // width x SAR / height for video; 0 means width / height
 };
 
 struct LayoutDecision {
@@ -72,21 +68,24 @@ struct LayoutDecision {
   std::string warning;  // non-empty when the result is a guess the user should know about
 };
 
-// Detection order: explicit flag -> metadata (half or full from the frame's aspect, with the
-// thresholds of the aspect rule: side-by-side is full when W/H >= 3, top-bottom when W/H <= 1)
-// -> exact HDMI frame-packed frame size -> filename
+// Detection order: explicit flag -> metadata (layout_from_stereo_metadata: half or full from the
+// display aspect, see kFullSideBySideMinAspect) -> exact HDMI frame-packed frame size -> filename
 // tokens -> aspect (W/H >= 3 full SBS, W/H <= 1 full TAB) -> mono with a warning.
 // `.jps` files store right-left side-by-side by convention: they are sbs when nothing else says
-// otherwise, and their views are swapped whatever rule decided the layout.
+// otherwise, and their views are swapped whatever rule decided the layout. `evidence.swap_eyes`
+// (--swap-eyes) swaps on top of all that. Throws UnsupportedStereoMetadata when the metadata names
+// a packing nelf cannot split (checkerboard, interleaved) and no flag overrides it.
 LayoutDecision detect_stereo_layout(const LayoutEvidence& evidence);
 
-// The filename rule alone: release-name tokens (any case, delimited by non-alphanumerics), e.g.
-// "Movie.2010.3D.HSBS.1080p.mkv" -> sbs-half, "photo_rl.jpg" -> sbs swapped, "clip.3D.mp4" ->
-// sbs-half. Returns nothing when no token names a layout.
+// The filename rule alone: release-name tokens (any case, delimited by non-alphanumerics, in the
+// last path component only), e.g. "Movie.2010.3D.HSBS.1080p.mkv" -> sbs-half, "photo_rl.jpg" ->
+// sbs swapped, "clip.3D.mp4" -> sbs-half. `lr`/`rl` say side-by-side but not half or full: with a
+// known `display_aspect` (> 0) that decides as for metadata, otherwise they mean full sbs.
+// Returns nothing when no token names a layout.
 struct FilenameLayout {
   StereoLayout layout;
   bool swap_eyes = false;
 };
-std::optional<FilenameLayout> layout_from_filename(const std::filesystem::path& filename);
+std::optional<FilenameLayout> layout_from_filename(const std::filesystem::path& filename, double display_aspect = 0.0);
 
 }  // namespace nelf

@@ -47,9 +47,18 @@ class UnsupportedStereoMetadata : public std::runtime_error {
 };
 
 // Metadata never says whether side-by-side or top-bottom views are full or half resolution, so it
-// is inferred from the frame's display aspect (width × SAR / height): two full 16:9 views side by
-// side give 3.56, half (anamorphic) ones 1.78. The thresholds sit between the widest single-view
-// aspect in practice (2.39 scope) and the narrowest doubled one (4:3 doubled = 2.67).
+// is inferred from the frame's display aspect (width x SAR / height). This is the one place those
+// half/full thresholds live: the detection chain (inputs/stereo_layout.hpp) maps metadata only
+// through layout_from_stereo_metadata(), and the `lr`/`rl` filename tokens use the SBS one too.
+// Once something says the frame *is* stereo, the only question is half or full, so the threshold
+// sits between the widest single view in practice and the narrowest doubled one:
+//   side-by-side: half frames have one view's aspect (1920x1080 -> 1.78, scope at most 2.39); full
+//     frames twice it (3840x1080 -> 3.56, two 4:3 views 2.67). Full when >= 2.5.
+//   top-bottom: half frames have one view's aspect (1.33 .. 2.39); full frames half of it
+//     (1920x2160 -> 0.89, two 2.39 scope views stacked 1.20). Full when <= 1.25.
+// The aspect rule of DESIGN.md §6 (W/H >= 3 full SBS, W/H <= 1 full TAB) is deliberately stricter:
+// with no other evidence it must also leave 2D frames (a 2.39 scope film, a square photo) alone.
+// Every frame the aspect rule calls full, these thresholds call full as well.
 inline constexpr double kFullSideBySideMinAspect = 2.5;
 inline constexpr double kFullTopBottomMaxAspect = 1.25;
 

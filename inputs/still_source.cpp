@@ -347,9 +347,10 @@ StillStereo load_still(const fs::path& path, const StillOptions& options) {
 
   Image frame = read_image_file(path);
   StillStereo result;
-  result.decision = detect_stereo_layout({options.layout, std::nullopt, frame.width(), frame.height(), path});
+  result.decision =
+      detect_stereo_layout({options.layout, std::nullopt, frame.width(), frame.height(), path, options.swap_eyes});
   try {
-    result.views = split_frame(frame, result.decision.layout, result.decision.swap_eyes != options.swap_eyes);
+    result.views = split_frame(frame, result.decision.layout, result.decision.swap_eyes);
   } catch (const LayoutError& e) {
     const std::string hint = result.decision.rule == DetectionRule::flag
                                  ? std::string()

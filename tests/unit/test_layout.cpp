@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 
 #include "inputs/stereo_layout.hpp"
 
@@ -199,28 +200,23 @@ TEST(StereoLayout, FilenameLooksOnlyAtTheLastComponent) {
 TEST(StereoLayout, DetectionOrder) {
   // An explicit flag beats everything.
   auto d = detect_stereo_layout(
-      {StereoLayout::mono, StereoMetadata{StereoMetadata::Arrangement::side_by_side, true}, 1280, 1470, "x.hsbs.png"});
+      {StereoLayout::mono, StereoMetadata{StereoPacking::side_by_side, true}, 1280, 1470, "x.hsbs.png"});
   EXPECT_EQ(d.layout, StereoLayout::mono);
   EXPECT_EQ(to_string(d.rule), "flag");
   EXPECT_FALSE(d.swap_eyes);
 
   // Metadata beats frame size and filename; half or full from the aspect; invert means swap.
-  d = detect_stereo_layout(
-      {std::nullopt, StereoMetadata{StereoMetadata::Arrangement::side_by_side, true}, 1920, 1080, "x.ou.mkv"});
+  d = detect_stereo_layout({std::nullopt, StereoMetadata{StereoPacking::side_by_side, true}, 1920, 1080, "x.ou.mkv"});
   EXPECT_EQ(d.layout, StereoLayout::sbs_half);
   EXPECT_TRUE(d.swap_eyes);
   EXPECT_EQ(to_string(d.rule), "metadata");
-  d = detect_stereo_layout(
-      {std::nullopt, StereoMetadata{StereoMetadata::Arrangement::side_by_side, false}, 3840, 1080, "x.mkv"});
+  d = detect_stereo_layout({std::nullopt, StereoMetadata{StereoPacking::side_by_side, false}, 3840, 1080, "x.mkv"});
   EXPECT_EQ(d.layout, StereoLayout::sbs);
-  d = detect_stereo_layout(
-      {std::nullopt, StereoMetadata{StereoMetadata::Arrangement::top_bottom, false}, 1920, 2160, "x.mkv"});
+  d = detect_stereo_layout({std::nullopt, StereoMetadata{StereoPacking::top_bottom, false}, 1920, 2160, "x.mkv"});
   EXPECT_EQ(d.layout, StereoLayout::tab);
-  d = detect_stereo_layout(
-      {std::nullopt, StereoMetadata{StereoMetadata::Arrangement::top_bottom, false}, 1920, 1080, "x.mkv"});
+  d = detect_stereo_layout({std::nullopt, StereoMetadata{StereoPacking::top_bottom, false}, 1920, 1080, "x.mkv"});
   EXPECT_EQ(d.layout, StereoLayout::tab_half);
-  d = detect_stereo_layout(
-      {std::nullopt, StereoMetadata{StereoMetadata::Arrangement::frame_sequential, false}, 1920, 1080, "x.mkv"});
+  d = detect_stereo_layout({std::nullopt, StereoMetadata{StereoPacking::frame_sequence, false}, 1920, 1080, "x.mkv"});
   EXPECT_EQ(d.layout, StereoLayout::alt);
 
   // The HDMI frame-packed sizes beat filename tokens.
@@ -266,6 +262,131 @@ TEST(StereoLayout, JpsIsRightLeftSideBySide) {
   EXPECT_EQ(d.layout, StereoLayout::sbs_half);
   EXPECT_TRUE(d.swap_eyes);
   EXPECT_FALSE(detect_stereo_layout({std::nullopt, std::nullopt, 2048, 768, "photo.jpg"}).swap_eyes);
+}
+
+// Merged from the video side's chain (formerly tests/unit/test_layout_chain.cpp).
+LayoutEvidence plain(int width, int height, std::string path = "movie.mkv") {
+  LayoutEvidence e;
+  e.width = width;
+  e.height = height;
+  e.display_aspect = static_cast<double>(width) / height;
+  e.filename = std::move(path);
+  return e;
+}
+
+TEST(LayoutChain, FlagWinsOverEverything) {
+  LayoutEvidence e = plain(1280, 1470, "film.hsbs.mkv");
+  e.metadata = StereoMetadata{StereoPacking::top_bottom, true};
+  e.flag = StereoLayout::sbs;
+  const LayoutDecision d = detect_stereo_layout(e);
+  EXPECT_EQ(d.layout, StereoLayout::sbs);
+  EXPECT_EQ(d.rule, DetectionRule::flag);
+  EXPECT_FALSE(d.swap_eyes) << "with an explicit layout only --swap-eyes swaps";
+  e.swap_eyes = true;
+  EXPECT_TRUE(detect_stereo_layout(e).swap_eyes);
+}
+
+TEST(LayoutChain, MetadataWinsOverFrameSizeAndName) {
+  LayoutEvidence e = plain(1920, 2205, "film.hsbs.mkv");
+  e.metadata = StereoMetadata{StereoPacking::top_bottom, true};
+  const LayoutDecision d = detect_stereo_layout(e);
+  EXPECT_EQ(d.layout, StereoLayout::tab);  // 1920x2205 is taller than wide: full top-bottom
+  EXPECT_TRUE(d.swap_eyes);
+  EXPECT_EQ(d.rule, DetectionRule::metadata);
+  e.swap_eyes = true;  // --swap-eyes swaps what was detected
+  EXPECT_FALSE(detect_stereo_layout(e).swap_eyes);
+}
+
+TEST(LayoutChain, MetadataHalfOrFullUsesTheDisplayAspect) {
+  // Two 4:3 views side by side (2.67) are full; the aspect rule alone (>= 3) would not say so.
+  LayoutEvidence e = plain(1440, 540);
+  e.metadata = StereoMetadata{StereoPacking::side_by_side, false};
+  EXPECT_EQ(detect_stereo_layout(e).layout, StereoLayout::sbs);
+  // Anamorphic pixels: a 1440x1080 frame with 4:3 SAR is displayed at 1.78, so half.
+  e = plain(1440, 1080);
+  e.display_aspect = 16.0 / 9.0;
+  e.metadata = StereoMetadata{StereoPacking::side_by_side, false};
+  EXPECT_EQ(detect_stereo_layout(e).layout, StereoLayout::sbs_half);
+  // Two 2.39 scope views stacked (1.20) are full top-bottom.
+  e = plain(1920, 1606);
+  e.metadata = StereoMetadata{StereoPacking::top_bottom, false};
+  EXPECT_EQ(detect_stereo_layout(e).layout, StereoLayout::tab);
+  e.metadata = StereoMetadata{StereoPacking::mono, false};
+  EXPECT_EQ(detect_stereo_layout(e).layout, StereoLayout::mono);
+  EXPECT_EQ(detect_stereo_layout(e).rule, DetectionRule::metadata);
+}
+
+TEST(LayoutChain, HdmiFramePackedSizesAreFramePacked) {
+  for (auto [w, h] : {std::pair{1280, 1470}, std::pair{1920, 2205}}) {
+    const LayoutDecision d = detect_stereo_layout(plain(w, h, "film.sbs.mkv"));
+    EXPECT_EQ(d.layout, StereoLayout::fp);
+    EXPECT_EQ(d.rule, DetectionRule::frame_size);
+  }
+  EXPECT_NE(detect_stereo_layout(plain(1280, 1472)).rule, DetectionRule::frame_size);
+}
+
+TEST(LayoutChain, FilenameThenAspectThenMono) {
+  const LayoutDecision by_name = detect_stereo_layout(plain(1920, 1080, "/films/Some.Movie.2011.H-SBS.1080p.mkv"));
+  EXPECT_EQ(by_name.layout, StereoLayout::sbs_half);
+  EXPECT_EQ(by_name.rule, DetectionRule::filename);
+
+  const LayoutDecision by_aspect = detect_stereo_layout(plain(3840, 1080));
+  EXPECT_EQ(by_aspect.layout, StereoLayout::sbs);
+  EXPECT_EQ(by_aspect.rule, DetectionRule::aspect);
+
+  const LayoutDecision fallback = detect_stereo_layout(plain(1920, 1080));
+  EXPECT_EQ(fallback.layout, StereoLayout::mono);
+  EXPECT_EQ(fallback.rule, DetectionRule::fallback);
+  EXPECT_EQ(to_string(fallback.rule), "default");
+  EXPECT_FALSE(fallback.warning.empty());
+}
+
+TEST(LayoutChain, UnsupportedMetadataIsAnErrorUnlessOverridden) {
+  LayoutEvidence e = plain(1920, 1080);
+  e.metadata = StereoMetadata{StereoPacking::checkerboard, false};
+  EXPECT_THROW(detect_stereo_layout(e), UnsupportedStereoMetadata);
+  e.flag = StereoLayout::sbs_half;
+  EXPECT_EQ(detect_stereo_layout(e).layout, StereoLayout::sbs_half);
+}
+
+TEST(LayoutHints, FilenameTokens) {
+  const double hd = 16.0 / 9.0;
+  EXPECT_EQ(layout_from_filename("a.HSBS.mkv", hd)->layout, StereoLayout::sbs_half);
+  EXPECT_EQ(layout_from_filename("a.half-ou.mkv", hd)->layout, StereoLayout::tab_half);
+  EXPECT_EQ(layout_from_filename("a_h-tab.mkv", hd)->layout, StereoLayout::tab_half);
+  EXPECT_EQ(layout_from_filename("a.full-sbs.mkv", hd)->layout, StereoLayout::sbs);
+  EXPECT_EQ(layout_from_filename("a.full-ou.mkv", hd)->layout, StereoLayout::tab);
+  EXPECT_EQ(layout_from_filename("a.full-tab.mkv", hd)->layout, StereoLayout::tab);
+  EXPECT_EQ(layout_from_filename("a.half-tab.mkv", hd)->layout, StereoLayout::tab_half);
+  EXPECT_EQ(layout_from_filename("a.FOU.mkv", hd)->layout, StereoLayout::tab);
+  EXPECT_EQ(layout_from_filename("a 3D.mkv", hd)->layout, StereoLayout::sbs_half);
+  const auto rl = layout_from_filename("holiday.rl.mp4", 2 * hd);
+  ASSERT_TRUE(rl.has_value());
+  EXPECT_EQ(rl->layout, StereoLayout::sbs);
+  EXPECT_TRUE(rl->swap_eyes);
+  EXPECT_FALSE(layout_from_filename("/sbs/plain-movie.mkv", hd).has_value()) << "only the file's own name";
+  EXPECT_FALSE(layout_from_filename("subsonic.mkv", hd).has_value()) << "tokens, not substrings";
+}
+
+TEST(LayoutHints, LeftRightTokensAreHalfOrFullByTheAspect) {
+  // `lr`/`rl` say side-by-side only: at a single view's aspect the views are half width.
+  const auto rl = layout_from_filename("holiday.rl.mp4", 16.0 / 9.0);
+  ASSERT_TRUE(rl.has_value());
+  EXPECT_EQ(rl->layout, StereoLayout::sbs_half);
+  EXPECT_TRUE(rl->swap_eyes);
+  EXPECT_EQ(layout_from_filename("holiday.lr.mp4", 16.0 / 9.0)->layout, StereoLayout::sbs_half);
+  // Without an aspect they mean full side-by-side (the common stills convention).
+  EXPECT_EQ(layout_from_filename("holiday.lr.jpg")->layout, StereoLayout::sbs);
+  const LayoutDecision d = detect_stereo_layout({std::nullopt, std::nullopt, 1920, 1080, "clip_RL.mkv"});
+  EXPECT_EQ(d.layout, StereoLayout::sbs_half);
+  EXPECT_TRUE(d.swap_eyes);
+  EXPECT_EQ(d.rule, DetectionRule::filename);
+}
+
+TEST(LayoutChain, SwapEyesFlagComesOnTopOfJps) {
+  LayoutEvidence e{std::nullopt, std::nullopt, 2048, 768, "photo.jps"};
+  e.swap_eyes = true;
+  EXPECT_FALSE(detect_stereo_layout(e).swap_eyes) << "--swap-eyes undoes the JPS convention";
 }
 
 }  // namespace
