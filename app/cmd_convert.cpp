@@ -7,7 +7,10 @@
 #include <optional>
 #include <string>
 
+#include <algorithm>
+#include <filesystem>
 #include "app/commands.hpp"
+#include "app/convert_video.hpp"
 #include "compositor/make_compositor.hpp"
 #include "compositor/profile.hpp"
 #include "hmz_output/image_sink.hpp"
@@ -15,6 +18,8 @@
 #include "hmz_output/signal.hpp"
 #include "inputs/stereo_layout.hpp"
 #include "inputs/still_source.hpp"
+#include "inputs/synthetic_source.hpp"
+#include "inputs/video_source.hpp"
 
 namespace nelf::app {
 namespace {
@@ -31,7 +36,23 @@ struct ConvertArgs {
   std::optional<int> gpu;
   int bits = 8;
   bool overwrite = false;
+  // Video only.
+  std::string codec = "h264";
+  std::optional<int> crf;
+  std::optional<double> start, duration;
+  std::optional<long> frames;
+  bool no_audio = false, quiet = false, strict = false, allow_network = false;
 };
+
+// Still images go through OpenImageIO; everything else (and `synthetic:`) is video.
+bool is_still_image(const std::string& path) {
+  if (is_synthetic_spec(path)) return false;
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  static const std::vector<std::string> still = {".png", ".jpg",  ".jpeg", ".jps", ".mpo", ".tif", ".tiff", ".exr",
+                                                 ".bmp", ".webp", ".tga",  ".ppm", ".pnm", ".hdr", ".dpx"};
+  return std::find(still.begin(), still.end(), ext) != still.end();
+}
 
 // Everything that can be checked without reading the input, checked before any work.
 struct ConvertPlan {
@@ -90,7 +111,65 @@ ConvertPlan plan_convert(const ConvertArgs& args) {
   return plan;
 }
 
+void run_convert_video(const ConvertArgs& args) {
+  VideoConvertRequest r;
+  r.input = args.input;
+  r.right = args.right;
+  r.output = args.output;
+  if (args.layout != "auto") {
+    r.layout = parse_stereo_layout(args.layout);
+    if (!r.layout)
+      throw UserError(
+          fmt::format("unknown layout '{}' (use auto, {})", args.layout, fmt::join(stereo_layout_names(), ", ")), 2);
+    if (*r.layout == StereoLayout::pair && args.right.empty())
+      throw UserError("layout pair needs the right view as a second file (--right FILE)", 2);
+  }
+  if (!args.right.empty() && r.layout != StereoLayout::pair)
+    throw UserError("--right gives the right view as a second file: use it with --layout pair", 2);
+  r.swap_eyes = args.swap_eyes;
+  try {
+    validate_fsaa(args.fsaa);
+  } catch (const std::invalid_argument& e) {
+    throw UserError(e.what(), 2);
+  }
+  r.compositor.fsaa = args.fsaa;
+  r.compositor.gpu = args.gpu;
+  r.profile = load_profile(args.profile);
+  const std::string signal_name = args.signal.empty() ? r.profile.signal : args.signal;
+  const auto signal = find_signal(signal_name);
+  if (!signal)
+    throw UserError(fmt::format("unknown signal '{}' (use {})", signal_name, fmt::join(signal_names(), ", ")), 2);
+  r.signal = *signal;
+  r.encoder.codec = args.codec;
+  r.encoder.crf = args.crf;
+  r.encoder.overwrite = args.overwrite;
+  r.encoder.audio = !args.no_audio;
+  if (args.crf && (*args.crf < 0 || *args.crf > 51))
+    throw UserError(fmt::format("--crf must be 0..51, got {}", *args.crf), 2);
+  if (args.start && *args.start < 0) throw UserError(fmt::format("--start must be >= 0, got {}", *args.start), 2);
+  if (args.duration && *args.duration <= 0)
+    throw UserError(fmt::format("--duration must be > 0, got {}", *args.duration), 2);
+  if (args.frames && *args.frames <= 0) throw UserError(fmt::format("--frames must be > 0, got {}", *args.frames), 2);
+  r.start_s = args.start;
+  r.duration_s = args.duration;
+  r.max_frames = args.frames;
+  r.quiet = args.quiet;
+  r.strict = args.strict;
+  r.allow_network = args.allow_network;
+  const std::filesystem::path out(args.output);
+  const auto dir = out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path();
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec))
+    throw UserError(fmt::format("{}: cannot write: directory {} does not exist", args.output, dir.string()), 1);
+  if (!is_image_sequence_pattern(args.output) && std::filesystem::exists(out, ec) && !args.overwrite)
+    throw UserError(fmt::format("{}: already exists; pass -y to overwrite", args.output), 1);
+  if (!args.quiet) quiet_ffmpeg_logs(true);
+  convert_video(r);
+}
+
 void run_convert(const ConvertArgs& args) {
+  quiet_ffmpeg_logs(true);
+  if (!is_still_image(args.input)) return run_convert_video(args);
   const ConvertPlan plan = plan_convert(args);
   StillStereo still;
   try {
@@ -114,7 +193,8 @@ void run_convert(const ConvertArgs& args) {
 
 void add_convert_command(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();
-  auto* cmd = app.add_subcommand("convert", "Convert a stereo still image into the display's output frame");
+  auto* cmd =
+      app.add_subcommand("convert", "Convert a stereo image or video (or synthetic:) into what the display needs");
   cmd->add_option("input", args->input, "Stereo image (side-by-side, top-bottom, frame-packed, JPS, MPO, ...)")
       ->required();
   cmd->add_option("output", args->output, "Output image (.png, .tif, .exr, .jpg)")->required();
@@ -134,6 +214,16 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--bits", args->bits, "Bits per channel of the output file: 8, or 16 for .png/.tif")
       ->capture_default_str();
   cmd->add_flag("-y,--overwrite", args->overwrite, "Replace the output file if it exists");
+  cmd->add_option("--codec", args->codec, "Video: h264, hevc, ffv1 or any FFmpeg video encoder")->capture_default_str();
+  cmd->add_option("--crf", args->crf, "Video: quality for h264/hevc (0 best .. 51; default 18)");
+  cmd->add_option("--start", args->start, "Video: start at this time (seconds)");
+  cmd->add_option("--duration", args->duration, "Video: convert this many seconds");
+  cmd->add_option("--frames", args->frames, "Video: convert at most this many frames");
+  cmd->add_flag("--no-audio", args->no_audio, "Video: leave the audio out");
+  cmd->add_flag("--quiet", args->quiet, "Video: no progress output");
+  cmd->add_flag("--strict", args->strict, "Video: a damaged or truncated input is an error");
+  cmd->add_flag("--allow-network", args->allow_network,
+                "Let FFmpeg use network protocols (default: files and pipes only)");
   cmd->callback([args] { run_convert(*args); });
 }
 

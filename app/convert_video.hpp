@@ -1,0 +1,38 @@
+#pragma once
+// `nelf convert` for video: decode → composite (GL) → encode on three threads with bounded queues.
+#include <optional>
+#include <string>
+
+#include "compositor/compositor.hpp"
+#include "compositor/profile.hpp"
+#include "hmz_output/signal.hpp"
+#include "hmz_output/video_encoder.hpp"
+#include "inputs/stereo_layout.hpp"
+
+namespace nelf::app {
+
+struct VideoConvertRequest {
+  std::string input;   // a media file or `synthetic:[options]`
+  std::string right;   // second input for layout pair
+  std::string output;  // a video file, or an image sequence pattern such as frames_%05d.png
+  Profile profile;
+  Signal signal;
+  CompositorOptions compositor;
+  std::optional<StereoLayout> layout;  // nullopt: detect
+  bool swap_eyes = false;
+  EncoderSettings encoder;
+  std::optional<double> start_s, duration_s;
+  std::optional<long> max_frames;
+  bool quiet = false;
+  bool strict = false;
+  bool allow_network = false;
+};
+
+// True when `output` names an image sequence (a printf pattern like %05d).
+bool is_image_sequence_pattern(const std::string& output);
+
+// Runs the conversion. Throws UserError (status 1 for failed jobs, 130 when interrupted); leaves no
+// output behind on any failure.
+void convert_video(const VideoConvertRequest& request);
+
+}  // namespace nelf::app
