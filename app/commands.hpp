@@ -22,5 +22,6 @@ using CommandRegistrar = void (*)(CLI::App& app);
 
 void add_profiles_command(CLI::App& app);
 void add_design_command(CLI::App& app);
+void add_simulate_command(CLI::App& app);
 
 }  // namespace nelf::app

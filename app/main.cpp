@@ -11,6 +11,7 @@ namespace {
 constexpr nelf::app::CommandRegistrar registrars[] = {
     nelf::app::add_profiles_command,
     nelf::app::add_design_command,
+    nelf::app::add_simulate_command,
 };
 
 }  // namespace
