@@ -24,5 +24,6 @@ void add_profiles_command(CLI::App& app);
 void add_design_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
 void add_probe_command(CLI::App& app);
+void add_simulate_command(CLI::App& app);
 
 }  // namespace nelf::app

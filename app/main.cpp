@@ -13,6 +13,7 @@ constexpr nelf::app::CommandRegistrar registrars[] = {
     nelf::app::add_design_command,
     nelf::app::add_convert_command,
     nelf::app::add_probe_command,
+    nelf::app::add_simulate_command,
 };
 
 }  // namespace

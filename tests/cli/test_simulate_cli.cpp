@@ -1,0 +1,226 @@
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <vector>
+
+#include "support/test_support.hpp"
+
+namespace nelf::test {
+namespace {
+
+// hmz-t1 optics with a quarter of its pixels per axis (4× the pitch): same lens block, field of view and
+// eye box, fast enough for a CLI test. `extra` is appended (e.g. a calibration table).
+std::string small_profile(const std::string& extra = "") {
+  return R"(
+name = "small"
+[display]
+resolution = [320, 180]
+pixel_pitch_mm = 0.048
+[lens_array]
+pitch_mm = 1.0
+focal_length_mm = 3.3
+[viewing]
+eye_relief_mm = 25.0
+virtual_image_mm = 1000.0
+pupil_mm = 4.0
+ipd_mm = 63.0
+)" + extra;
+}
+
+// A 256×144 PNG with blocks, a ramp and rings: detail the small display can just resolve.
+void write_test_still(const std::filesystem::path& path) {
+  const int w = 256, h = 144;
+  std::vector<unsigned char> pixels(static_cast<std::size_t>(w * h * 3));
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const double u = (x + 0.5) / w, t = (y + 0.5) / h;
+      const bool block = (static_cast<int>(u * 8) + static_cast<int>(t * 4.5)) % 2 == 0;
+      const double ring = std::hypot((u - 0.5) * 16.0 / 9.0, t - 0.5);
+      unsigned char* p = &pixels[static_cast<std::size_t>((y * w + x) * 3)];
+      p[0] = block ? 204 : 51;
+      p[1] = static_cast<unsigned char>(51 + 153 * u);
+      p[2] = static_cast<unsigned char>(127.5 + 127 * std::cos(2 * std::numbers::pi * ring * 3));
+    }
+  }
+  auto out = OIIO::ImageOutput::create(path.string());
+  ASSERT_TRUE(out);
+  ASSERT_TRUE(out->open(path.string(), OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::UINT8)));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+  ASSERT_TRUE(out->close());
+}
+
+struct Fixture {
+  TempDir dir;
+  std::filesystem::path still = dir / "still.png";
+  std::filesystem::path profile = dir / "small.toml";
+  std::filesystem::path retina = dir / "retina.png";
+  Fixture(const std::string& profile_extra = "") {
+    write_test_still(still);
+    write_file(profile, small_profile(profile_extra));
+  }
+  // `nelf simulate STILL --profile small.toml -o retina.png ARGS`
+  CommandResult simulate(const std::string& args) const {
+    return run_nelf("simulate " + shell_quote(still.string()) + " --profile " + shell_quote(profile.string()) + " -o " +
+                    shell_quote(retina.string()) + " " + args);
+  }
+  double psnr(const std::string& args) const {
+    const CommandResult r = simulate("--json " + args);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(r.out).at("psnr_db").get<double>();
+  }
+};
+
+// One line on stderr, prefixed like every nelf error, non-zero exit.
+void expect_one_line_error(const CommandResult& r, const std::string& fragment) {
+  EXPECT_NE(r.status, 0);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("nelf: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(fragment), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+std::array<int, 2> image_size(const std::filesystem::path& path) {
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) return {0, 0};
+  return {in->spec().width, in->spec().height};
+}
+
+TEST(SimulateCli, JsonSchemaAndRetinalImage) {
+  Fixture f;
+  const CommandResult r = f.simulate("--json --ideal " + shell_quote((f.dir / "ideal.png").string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << "exactly one line of JSON: " << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.is_object());
+  ASSERT_TRUE(j.at("psnr_db").is_number());
+  EXPECT_GT(j["psnr_db"].get<double>(), 25.0);               // measured 30.0 dB
+  EXPECT_DOUBLE_EQ(j.at("focus_mm").get<double>(), 1000.0);  // default: the screen distance
+  EXPECT_DOUBLE_EQ(j.at("pupil_mm").get<double>(), 4.0);     // default: viewing.pupil_mm
+  EXPECT_EQ(j.at("eye"), "left");
+  const auto size = j.at("retina_size").get<std::array<int, 2>>();
+  EXPECT_EQ(image_size(f.retina), size);
+  EXPECT_EQ(image_size(f.dir / "ideal.png"), size);
+  EXPECT_GT(size[0], size[1]);  // the screen is 16:9, upright
+  // Nothing left behind but the requested files.
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(f.dir.path())) ++files;
+  EXPECT_EQ(files, 4);
+}
+
+TEST(SimulateCli, FocusPupilAndEyeOptions) {
+  Fixture f;
+  CommandResult r = f.simulate("--json --focus-mm 250 --pupil-mm 3 --eye right --eye-offset-mm 0.5,-0.25");
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_DOUBLE_EQ(j.at("focus_mm").get<double>(), 250.0);
+  EXPECT_DOUBLE_EQ(j.at("pupil_mm").get<double>(), 3.0);
+  EXPECT_EQ(j.at("eye"), "right");
+  EXPECT_EQ(j.at("eye_offset_mm"), nlohmann::json({0.5, -0.25}));
+  r = f.simulate("--json --focus-mm inf");
+  ASSERT_EQ(r.status, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j.at("focus_mm").is_null());  // focused at infinity
+  EXPECT_TRUE(j.at("psnr_db").is_number());
+  r = f.simulate("");  // human-readable summary
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("PSNR ", 0), 0u) << r.out;
+}
+
+TEST(SimulateCli, MiscalibratedRenderingLosesPsnr) {
+  // The rendering is calibrated for a sheet shifted by half an elemental image (1.1316 mm / 0.048 mm / 2
+  // = 11.8 px) while the simulated hardware is the nominal one: the eye looks into the wrong views.
+  const double aligned = Fixture().psnr("");
+  const double misaligned = Fixture("[calibration.left]\nshift_px = [11.8, 0.0]\n").psnr("");
+  EXPECT_LT(misaligned, aligned - 10.0) << "aligned " << aligned << " dB";
+}
+
+TEST(SimulateCli, EyeFarOutsideTheEyeBoxDegrades) {
+  Fixture f;
+  const double centred = f.psnr("");
+  EXPECT_GT(f.psnr("--eye-offset-mm 1,0"), centred - 4.0);
+  EXPECT_LT(f.psnr("--eye-offset-mm 8,0"), centred - 15.0);
+}
+
+TEST(SimulateCli, SweepWritesTableAndHeatmap) {
+  Fixture f;
+  const auto csv = f.dir / "sweep.csv";
+  const CommandResult r = f.simulate("--json --sweep " + shell_quote(csv.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string table = read_file(csv);
+  EXPECT_EQ(table.rfind("screen_diopters,screen_mm,accommodation_diopters,accommodation_mm,psnr_db", 0), 0u);
+  EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 1 + 9 * 17);  // 9 screen distances × 17 accommodations
+  EXPECT_NE(table.find("\n1,1000.0,0,inf,"), std::string::npos) << "infinity row for the 1 m screen";
+  EXPECT_NE(table.find("\n4,250.0,4,250.0,"), std::string::npos);
+  const auto heatmap = image_size(f.dir / "sweep.png");
+  EXPECT_GT(heatmap[0], 600);
+  EXPECT_GT(heatmap[1], 300);
+}
+
+TEST(SimulateCli, UnreadableImage) {
+  Fixture f;
+  write_file(f.still, "this is not an image");
+  expect_one_line_error(f.simulate(""), "cannot read image");
+  EXPECT_FALSE(std::filesystem::exists(f.retina));
+  std::filesystem::remove(f.still);
+  expect_one_line_error(f.simulate(""), "cannot read image");
+  EXPECT_FALSE(std::filesystem::exists(f.retina));
+}
+
+TEST(SimulateCli, BadEyeValue) {
+  Fixture f;
+  const CommandResult r = f.simulate("--eye middle");
+  expect_one_line_error(r, "--eye");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_FALSE(std::filesystem::exists(f.retina));
+}
+
+TEST(SimulateCli, BadEyeOffsetSyntax) {
+  Fixture f;
+  for (const char* bad : {"1;2", "abc", "1,", ",2", "1,2,3", "1,nan"}) {
+    const CommandResult r = f.simulate(std::string("--eye-offset-mm ") + shell_quote(bad));
+    expect_one_line_error(r, "--eye-offset-mm must be two numbers");
+    EXPECT_EQ(r.status, 2) << bad;
+    EXPECT_FALSE(std::filesystem::exists(f.retina)) << bad;
+  }
+}
+
+TEST(SimulateCli, BadFocusAndPupil) {
+  Fixture f;
+  expect_one_line_error(f.simulate("--focus-mm -3"), "--focus-mm");
+  expect_one_line_error(f.simulate("--focus-mm far"), "--focus-mm");
+  expect_one_line_error(f.simulate("--pupil-mm 0"), "--pupil-mm");
+  EXPECT_FALSE(std::filesystem::exists(f.retina));
+}
+
+TEST(SimulateCli, UnwritableOutput) {
+  Fixture f;
+  const auto missing_dir = f.dir / "no-such-dir" / "retina.png";
+  CommandResult r = run_nelf("simulate " + shell_quote(f.still.string()) + " --profile " +
+                             shell_quote(f.profile.string()) + " -o " + shell_quote(missing_dir.string()));
+  expect_one_line_error(r, "cannot write --output");
+  r = f.simulate("--ideal " + shell_quote(f.dir.path().string()));  // a directory
+  expect_one_line_error(r, "cannot write --ideal");
+  EXPECT_FALSE(std::filesystem::exists(f.retina));
+  // An extension no image format claims: refused up front, nothing written.
+  r = run_nelf("simulate " + shell_quote(f.still.string()) + " --profile " + shell_quote(f.profile.string()) + " -o " +
+               shell_quote((f.dir / "retina.nosuchformat").string()));
+  expect_one_line_error(r, "no image format");
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(f.dir.path())) ++files;
+  EXPECT_EQ(files, 2);  // still.png and small.toml
+}
+
+TEST(SimulateCli, StockProfileIsRejected) {
+  Fixture f;
+  const CommandResult r = run_nelf("simulate " + shell_quote(f.still.string()) + " --profile hmz-t1-stock -o " +
+                                   shell_quote(f.retina.string()));
+  expect_one_line_error(r, "lens_array");
+  EXPECT_FALSE(std::filesystem::exists(f.retina));
+}
+
+}  // namespace
+}  // namespace nelf::test
