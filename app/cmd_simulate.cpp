@@ -12,12 +12,15 @@
 #include <optional>
 #include <system_error>
 
+#include <fmt/ranges.h>
 #include "app/commands.hpp"
 #include "app/heatmap.hpp"
-#include "app/image_files.hpp"
 #include "compositor/eye_simulator.hpp"
+#include "compositor/make_compositor.hpp"
 #include "compositor/mapping.hpp"
 #include "compositor/reference.hpp"
+#include "hmz_output/image_sink.hpp"
+#include "inputs/still_source.hpp"
 
 namespace nelf::app {
 
@@ -25,10 +28,11 @@ namespace {
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
-// The compositing step, kept in one place: today the CPU reference with 4×4 sub-samples on a mono view;
-// the GL compositor (make_compositor) and stereo layout splitting replace it here.
+// The compositing step: what the display shows for `eye`, rendered the way `nelf convert` renders it
+// (the GL compositor at the default antialiasing).
 Image composite_eye_image(const Profile& profile, Eye eye, const View& view) {
-  return reference_eye_image(make_eye_mapping(profile, eye, view.aspect()), view.image, 4);
+  EyeImages eyes = make_compositor(profile, CompositorOptions{})->compose({view, view});
+  return std::move(eyes[static_cast<int>(eye)]);
 }
 
 struct SimulateArgs {
@@ -42,6 +46,9 @@ struct SimulateArgs {
   std::string ideal;
   std::string sweep;
   bool json = false;
+  std::string layout = "auto";
+  std::string right;
+  bool swap_eyes = false;
 };
 
 double parse_number(std::string_view text, bool& ok) {
@@ -134,27 +141,18 @@ void run_sweep(const SimulateArgs& args, const Profile& profile, Eye eye, const 
     }
   }
 
-  const auto tmp = temporary_name_for(csv_path);
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << csv;
-    out.close();
-    if (!out) {
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw UserError(fmt::format("cannot write sweep '{}'", csv_path.string()));
-    }
-  }
+  // The heatmap first, then the table: a failure leaves neither half-written.
+  write_heatmap_png(map, std::filesystem::path(csv_path).replace_extension(".png"));
   try {
-    write_heatmap_png(map, std::filesystem::path(csv_path).replace_extension(".png"));
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw;
+    write_file_atomically(csv_path, true, [&](const std::filesystem::path& temporary) {
+      std::ofstream out(temporary, std::ios::binary);
+      out << csv;
+      out.close();
+      if (!out) throw UserError(fmt::format("cannot write sweep '{}'", csv_path.string()));
+    });
+  } catch (const ImageWriteError& e) {
+    throw UserError(e.what());
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, csv_path, ec);
-  if (ec) throw UserError(fmt::format("cannot write sweep '{}': {}", csv_path.string(), ec.message()));
 }
 
 void run_simulate(const SimulateArgs& args) {
@@ -171,25 +169,49 @@ void run_simulate(const SimulateArgs& args) {
   check_writable(args.output, "--output");
   check_writable(args.ideal, "--ideal");
   check_writable(args.sweep, "--sweep");
-  check_image_format(args.output, "--output");
-  if (!args.ideal.empty()) check_image_format(args.ideal, "--ideal");
+  StillOptions still;
+  if (args.layout != "auto") {
+    still.layout = parse_stereo_layout(args.layout);
+    if (!still.layout)
+      throw UserError(
+          fmt::format("unknown layout '{}' (use auto, {})", args.layout, fmt::join(stereo_layout_names(), ", ")), 2);
+  }
+  if (!args.right.empty()) still.right = args.right;
+  still.swap_eyes = args.swap_eyes;
+  try {
+    check_image_writable(args.output, {true, 8});
+    if (!args.ideal.empty()) check_image_writable(args.ideal, {true, 8});
+  } catch (const ImageWriteError& e) {
+    throw UserError(e.what());
+  }
 
   const Profile profile = load_profile(args.profile);
   const DeviceOptics device = device_optics(profile, eye);  // a stock profile fails here, before any work
   eye_model.pupil_mm = args.pupil_mm.value_or(profile.viewing.pupil_mm);
   eye_model.focus_mm = focus_mm.value_or(render_distance_mm(profile));
 
-  // Mono for now: the still is the view of both eyes.
+  // The source's view for this eye (a stereo still in any layout; a 2D image is the view of both).
   View view;
-  view.image = read_still_image(args.input);
+  try {
+    StillStereo stereo = load_still(args.input, still);
+    if (!stereo.decision.warning.empty() && !args.json)
+      fmt::print(stderr, "nelf: warning: {}\n", stereo.decision.warning);
+    view = eye == Eye::left ? std::move(stereo.views.left) : std::move(stereo.views.right);
+  } catch (const StillError& e) {
+    throw UserError(e.what());
+  }
   const EyeMapping rendering = make_eye_mapping(profile, eye, view.aspect());
   const Image displayed = composite_eye_image(profile, eye, view);
   const EyeSimulator simulator(device, rendering, view.image);
   const SimulationResult result = simulator.simulate(displayed, eye_model);
 
   if (!args.sweep.empty()) run_sweep(args, profile, eye, view, eye_model, args.sweep);
-  write_image_file(result.retina, args.output);
-  if (!args.ideal.empty()) write_image_file(result.ideal, args.ideal);
+  try {
+    write_image_file(result.retina, args.output, {true, 8});
+    if (!args.ideal.empty()) write_image_file(result.ideal, args.ideal, {true, 8});
+  } catch (const ImageWriteError& e) {
+    throw UserError(e.what());
+  }
 
   const auto finite_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
   if (args.json) {
@@ -220,7 +242,14 @@ void add_simulate_command(CLI::App& app) {
       "simulate",
       "Simulate an eye looking at the display: composite IN for one eye, trace a thin-lens eye through the lens "
       "array, write the retinal image and the PSNR against the same eye looking at the emulated screen");
-  cmd->add_option("input", args->input, "Still image (used as the view of both eyes)")->required();
+  cmd->add_option("input", args->input,
+                  "Stereo still image (any layout nelf convert reads; a 2D image is used for both eyes)")
+      ->required();
+  cmd->add_option("--layout", args->layout,
+                  fmt::format("Stereo layout of the input: auto, {}", fmt::join(stereo_layout_names(), ", ")))
+      ->capture_default_str();
+  cmd->add_option("--right", args->right, "The right view as a separate image (layout pair)");
+  cmd->add_flag("--swap-eyes", args->swap_eyes, "The source stores the right view first");
   cmd->add_option("--profile", args->profile, "Device profile: built-in name or TOML file")->capture_default_str();
   cmd->add_option("--eye", args->eye, "Which eye")->check(CLI::IsMember({"left", "right"}))->capture_default_str();
   cmd->add_option("--focus-mm", args->focus,

@@ -10,7 +10,7 @@
 #include <system_error>
 
 #include "app/commands.hpp"
-#include "app/image_files.hpp"
+#include "hmz_output/image_sink.hpp"
 
 namespace nelf::app {
 
@@ -127,17 +127,13 @@ void write_heatmap_png(const Heatmap& map, const std::filesystem::path& path) {
   }
   canvas.text(bar_x + bar_w / 2, top - 14, map.value_label, 16, AlignX::Center);
 
-  const auto tmp = temporary_name_for(path);
-  if (!canvas.buffer().write(tmp.string(), OIIO::TypeDesc::UINT8, "png")) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw UserError(fmt::format("cannot write '{}': {}", path.string(), canvas.buffer().geterror()));
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw UserError(fmt::format("cannot write '{}': rename failed", path.string()));
+  try {
+    write_file_atomically(path, true, [&](const std::filesystem::path& temporary) {
+      if (!canvas.buffer().write(temporary.string(), OIIO::TypeDesc::UINT8, "png"))
+        throw UserError(fmt::format("cannot write '{}': {}", path.string(), canvas.buffer().geterror()));
+    });
+  } catch (const ImageWriteError& e) {
+    throw UserError(e.what());
   }
 }
 

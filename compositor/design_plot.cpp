@@ -1,5 +1,7 @@
 #include "compositor/design_plot.hpp"
 
+#include "hmz_output/image_sink.hpp"
+
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -343,23 +345,22 @@ void write_trade_space_plot(const Profile& profile, const std::filesystem::path&
 
   const OIIO::ImageBuf image = draw_plot(profile);
 
-  // Hidden temporary name with the same extension, so that OpenImageIO picks the same format.
-  const fs::path temporary =
-      directory / fmt::format(".{}.tmp-{}{}", path.stem().string(), ::getpid(), path.extension().string());
-  if (!image.write(temporary.string(), OIIO::TypeDesc::UINT8)) {
-    std::string why = image.geterror();
-    if (why.empty()) why = OIIO::geterror();  // format lookups report through the global error
-    fs::remove(temporary, ec);
-    if (why.empty()) why = "OpenImageIO could not write it";
-    // OpenImageIO's messages can span lines; the user gets one.
-    std::replace(why.begin(), why.end(), '\n', ' ');
-    throw PlotError(fmt::format("cannot write plot {}: {}", path.string(), why));
-  }
-  fs::rename(temporary, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
-    throw PlotError(fmt::format("cannot write plot {}: {}", path.string(), ec.message()));
+  // The format comes from the final name: the temporary file has no extension.
+  std::string format = path.extension().string().substr(1);
+  std::transform(format.begin(), format.end(), format.begin(), [](unsigned char c) { return std::tolower(c); });
+  try {
+    write_file_atomically(path, true, [&](const fs::path& temporary) {
+      if (!image.write(temporary.string(), OIIO::TypeDesc::UINT8, format)) {
+        std::string why = image.geterror();
+        if (why.empty()) why = OIIO::geterror();  // format lookups report through the global error
+        if (why.empty()) why = "OpenImageIO could not write it";
+        // OpenImageIO's messages can span lines; the user gets one.
+        std::replace(why.begin(), why.end(), '\n', ' ');
+        throw PlotError(fmt::format("cannot write plot {}: {}", path.string(), why));
+      }
+    });
+  } catch (const ImageWriteError& e) {
+    throw PlotError(fmt::format("plot: {}", e.what()));
   }
 }
 

@@ -164,26 +164,32 @@ void write_image_file(const Image& image, const fs::path& path, const ImageWrite
     throw ImageWriteError(fmt::format("cannot write {}: {}x{} exceeds JPEG's limit of {} pixels per side",
                                       path.string(), image.width(), image.height(), kMaxJpegDimension));
 
+  write_file_atomically(path, options.overwrite, [&](const fs::path& temporary) {
+    OIIO::TypeDesc pixel_type = options.bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8;
+    if (format == FileFormat::exr) pixel_type = OIIO::TypeDesc::HALF;
+    OIIO::ImageSpec spec(image.width(), image.height(), 3, pixel_type);
+    if (format == FileFormat::jpeg) spec.attribute("CompressionQuality", 95);
+
+    auto out = OIIO::ImageOutput::create(oiio_format_name(format));
+    if (!out)
+      throw ImageWriteError(
+          fmt::format("cannot write {}: no {} writer ({})", path.string(), oiio_format_name(format), OIIO::geterror()));
+    if (!out->open(temporary.string(), spec))
+      throw ImageWriteError(fmt::format("cannot write {}: {}", path.string(), out->geterror()));
+    // RGB out of the RGBA floats: a pixel stride of four floats skips alpha.
+    const auto pixel_stride = static_cast<OIIO::stride_t>(sizeof(Rgba));
+    const bool written =
+        out->write_image(OIIO::TypeDesc::FLOAT, image.data(), pixel_stride, pixel_stride * image.width());
+    const bool closed = out->close();
+    if (!written || !closed) throw ImageWriteError(fmt::format("cannot write {}: {}", path.string(), out->geterror()));
+  });
+}
+
+void write_file_atomically(const fs::path& path, bool overwrite, const std::function<void(const fs::path&)>& write) {
   const DeferredTermination no_interruptions;  // declared first: ends after the temporary file is gone
   TemporaryFile temp(path);
-  OIIO::TypeDesc pixel_type = options.bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8;
-  if (format == FileFormat::exr) pixel_type = OIIO::TypeDesc::HALF;
-  OIIO::ImageSpec spec(image.width(), image.height(), 3, pixel_type);
-  if (format == FileFormat::jpeg) spec.attribute("CompressionQuality", 95);
-
-  auto out = OIIO::ImageOutput::create(oiio_format_name(format));
-  if (!out)
-    throw ImageWriteError(
-        fmt::format("cannot write {}: no {} writer ({})", path.string(), oiio_format_name(format), OIIO::geterror()));
-  if (!out->open(temp.path().string(), spec))
-    throw ImageWriteError(fmt::format("cannot write {}: {}", path.string(), out->geterror()));
-  // RGB out of the RGBA floats: a pixel stride of four floats skips alpha.
-  const auto pixel_stride = static_cast<OIIO::stride_t>(sizeof(Rgba));
-  const bool written =
-      out->write_image(OIIO::TypeDesc::FLOAT, image.data(), pixel_stride, pixel_stride * image.width());
-  const bool closed = out->close();
-  if (!written || !closed) throw ImageWriteError(fmt::format("cannot write {}: {}", path.string(), out->geterror()));
-  temp.commit(path, options.overwrite);
+  write(temp.path());
+  temp.commit(path, overwrite);
 }
 
 }  // namespace nelf

@@ -3,6 +3,7 @@
 // .tiff, .exr, .jpg, .jpeg). The file appears complete or not at all: it is written under a
 // temporary name in the same directory and renamed at the end (DESIGN.md §11).
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 
 #include "compositor/image.hpp"
@@ -29,5 +30,12 @@ void check_image_writable(const std::filesystem::path& path, const ImageWriteOpt
 // clamped to 0..1 for integer formats. On any failure the temporary file is removed and nothing
 // appears at `path`.
 void write_image_file(const Image& image, const std::filesystem::path& path, const ImageWriteOptions& options);
+
+// Any file written without a half-written state: `write` fills a temporary file beside `path`
+// (a hidden name without the extension: name the format explicitly), which is then renamed into
+// place; refuses to replace an existing file unless `overwrite`. Ctrl-C is held back meanwhile.
+// Throws ImageWriteError (or what `write` throws) and leaves nothing behind on failure.
+void write_file_atomically(const std::filesystem::path& path, bool overwrite,
+                           const std::function<void(const std::filesystem::path& temporary)>& write);
 
 }  // namespace nelf

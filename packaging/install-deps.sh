@@ -12,8 +12,6 @@ packages=(
   # media: FFmpeg libraries, the ffmpeg CLI for test media and benchmarks, OpenImageIO
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libswresample-dev libavfilter-dev
   ffmpeg libopenimageio-dev
-  # a TrueType font for the labels of generated charts (nelf simulate --sweep)
-  fonts-dejavu-core
   # maths, configuration, CLI, formatting, JSON, audio
   libglm-dev libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libsdl2-dev
   # tests

@@ -163,10 +163,10 @@ TEST(SimulateCli, SweepWritesTableAndHeatmap) {
 TEST(SimulateCli, UnreadableImage) {
   Fixture f;
   write_file(f.still, "this is not an image");
-  expect_one_line_error(f.simulate(""), "cannot read image");
+  expect_one_line_error(f.simulate(""), "cannot read the image");
   EXPECT_FALSE(std::filesystem::exists(f.retina));
   std::filesystem::remove(f.still);
-  expect_one_line_error(f.simulate(""), "cannot read image");
+  expect_one_line_error(f.simulate(""), "no such file");
   EXPECT_FALSE(std::filesystem::exists(f.retina));
 }
 
@@ -208,7 +208,7 @@ TEST(SimulateCli, UnwritableOutput) {
   // An extension no image format claims: refused up front, nothing written.
   r = run_nelf("simulate " + shell_quote(f.still.string()) + " --profile " + shell_quote(f.profile.string()) + " -o " +
                shell_quote((f.dir / "retina.nosuchformat").string()));
-  expect_one_line_error(r, "no image format");
+  expect_one_line_error(r, "unknown image extension");
   int files = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(f.dir.path())) ++files;
   EXPECT_EQ(files, 2);  // still.png and small.toml
