@@ -21,6 +21,7 @@
 #include "compositor/reference.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "inputs/still_source.hpp"
+#include "inputs/synthetic_source.hpp"
 
 namespace nelf::app {
 
@@ -192,13 +193,23 @@ void run_simulate(const SimulateArgs& args) {
 
   // The source's view for this eye (a stereo still in any layout; a 2D image is the view of both).
   View view;
-  try {
-    StillStereo stereo = load_still(args.input, still);
-    if (!stereo.decision.warning.empty() && !args.json)
-      fmt::print(stderr, "nelf: warning: {}\n", stereo.decision.warning);
-    view = eye == Eye::left ? std::move(stereo.views.left) : std::move(stereo.views.right);
-  } catch (const StillError& e) {
-    throw UserError(e.what());
+  if (is_synthetic_spec(args.input)) {
+    // The built-in clip's first frame: lets the demo show what the eye sees without any media file.
+    try {
+      StereoPair pair = SyntheticClip(parse_synthetic_spec(args.input)).render(0);
+      view = eye == Eye::left ? std::move(pair.left) : std::move(pair.right);
+    } catch (const std::invalid_argument& e) {
+      throw UserError(e.what(), 2);
+    }
+  } else {
+    try {
+      StillStereo stereo = load_still(args.input, still);
+      if (!stereo.decision.warning.empty() && !args.json)
+        fmt::print(stderr, "nelf: warning: {}\n", stereo.decision.warning);
+      view = eye == Eye::left ? std::move(stereo.views.left) : std::move(stereo.views.right);
+    } catch (const StillError& e) {
+      throw UserError(e.what());
+    }
   }
   const EyeMapping rendering = make_eye_mapping(profile, eye, view.aspect());
   const Image displayed = composite_eye_image(profile, eye, view);
