@@ -1,5 +1,7 @@
 #include "inputs/stereo_layout.hpp"
 
+#include "inputs/view_regions.hpp"
+
 #include <fmt/format.h>
 #include <algorithm>
 #include <array>
@@ -40,7 +42,6 @@ Image crop(const Image& frame, int x0, int y0, int w, int h) {
 
 double ratio(int w, int h) { return static_cast<double>(w) / static_cast<double>(h); }
 
-std::string frame_size(const Image& frame) { return fmt::format("{}x{}", frame.width(), frame.height()); }
 
 // The aspect rule of DESIGN.md §6, used only when nothing else says the frame is stereo: a full
 // SBS frame is at least 3:1 (two 16:9 views are 3.56:1), a full TAB frame at most 1:1. Metadata and
@@ -101,55 +102,11 @@ std::optional<FramePackedGeometry> frame_packed_geometry(int width, int height) 
 }
 
 StereoPair split_frame(const Image& frame, StereoLayout layout, bool swap_eyes) {
-  if (frame.width() <= 0 || frame.height() <= 0)
-    throw LayoutError(fmt::format("layout {} does not fit an empty {} frame", to_string(layout), frame_size(frame)));
-  const int w = frame.width(), h = frame.height();
-  StereoPair pair;
-  switch (layout) {
-    case StereoLayout::sbs:
-    case StereoLayout::sbs_half: {
-      if (w % 2 != 0)
-        throw LayoutError(fmt::format("layout {} does not fit a {} frame: side-by-side needs an even width",
-                                      to_string(layout), frame_size(frame)));
-      // A full view keeps its own pixel aspect; a half view was squeezed to half width.
-      const double aspect = layout == StereoLayout::sbs ? ratio(w / 2, h) : ratio(w, h);
-      pair.left = View{crop(frame, 0, 0, w / 2, h), aspect};
-      pair.right = View{crop(frame, w / 2, 0, w / 2, h), aspect};
-      break;
-    }
-    case StereoLayout::tab:
-    case StereoLayout::tab_half: {
-      if (h % 2 != 0)
-        throw LayoutError(fmt::format("layout {} does not fit a {} frame: top-bottom needs an even height",
-                                      to_string(layout), frame_size(frame)));
-      const double aspect = layout == StereoLayout::tab ? ratio(w, h / 2) : ratio(w, h);
-      pair.left = View{crop(frame, 0, 0, w, h / 2), aspect};
-      pair.right = View{crop(frame, 0, h / 2, w, h / 2), aspect};
-      break;
-    }
-    case StereoLayout::fp: {
-      const auto g = frame_packed_geometry(w, h);
-      if (!g)
-        throw LayoutError(
-            fmt::format("layout fp does not fit a {} frame: HDMI frame packing is 1280x1470 (30-line gap) or 1920x2205 "
-                        "(45-line gap)",
-                        frame_size(frame)));
-      const double aspect = ratio(g->width, g->eye_height);
-      pair.left = View{crop(frame, 0, 0, w, g->eye_height), aspect};
-      pair.right = View{crop(frame, 0, g->eye_height + g->gap_rows, w, g->eye_height), aspect};
-      break;
-    }
-    case StereoLayout::mono:
-      pair.left = View{frame, ratio(w, h)};
-      pair.right = View{frame, ratio(w, h)};
-      break;
-    case StereoLayout::alt:
-      throw LayoutError("layout alt (frame-sequential) needs a video: one frame holds only one view");
-    case StereoLayout::pair:
-      throw LayoutError("layout pair needs two images (the right view with --right)");
-  }
-  if (swap_eyes) std::swap(pair.left, pair.right);
-  return pair;
+  const ViewRegions r = view_regions(layout, frame.width(), frame.height(), swap_eyes);
+  const auto view = [&](const PixelRect& rect) {
+    return View{crop(frame, rect.x, rect.y, rect.width, rect.height), r.display_aspect};
+  };
+  return StereoPair{view(r.left), view(r.right)};
 }
 
 std::string_view to_string(DetectionRule rule) {

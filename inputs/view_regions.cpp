@@ -48,9 +48,9 @@ ViewRegions view_regions(StereoLayout layout, int width, int height, bool swap_e
       r.display_aspect = frame_aspect;
       break;
     case StereoLayout::alt:
-      throw LayoutError("layout alt (frame-sequential) pairs consecutive frames; a single frame holds one view");
+      throw LayoutError("layout alt (frame-sequential) needs a video: one frame holds only one view");
     case StereoLayout::pair:
-      throw LayoutError("layout pair takes the right view from a second input (--right FILE)");
+      throw LayoutError("layout pair needs two images (the right view with --right)");
   }
   if (swap_eyes) std::swap(r.left, r.right);
   return r;
