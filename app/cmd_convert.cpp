@@ -63,43 +63,60 @@ struct ConvertPlan {
   ImageWriteOptions write;
 };
 
-ConvertPlan plan_convert(const ConvertArgs& args) {
-  ConvertPlan plan;
+// What stills and video share: the layout flags, antialiasing, device and signal, all checked
+// before any input is read. `still` refuses what only video can do (alt).
+struct CommonOptions {
+  std::optional<StereoLayout> layout;
+  CompositorOptions compositor;
+  Profile profile;
+  Signal signal;
+};
+
+CommonOptions parse_common_options(const ConvertArgs& args, bool still) {
+  CommonOptions common;
   if (args.layout != "auto") {
-    const auto layout = parse_stereo_layout(args.layout);
-    if (!layout)
+    common.layout = parse_stereo_layout(args.layout);
+    if (!common.layout)
       throw UserError(
           fmt::format("unknown layout '{}' (use auto, {})", args.layout, fmt::join(stereo_layout_names(), ", ")), 2);
-    if (*layout == StereoLayout::alt)
+    if (still && *common.layout == StereoLayout::alt)
       throw UserError("layout alt (frame-sequential) needs a video; a still holds one view per frame", 2);
-    if (*layout == StereoLayout::pair && args.right.empty())
+    if (*common.layout == StereoLayout::pair && args.right.empty())
       throw UserError("layout pair needs the right view as a second file (--right FILE)", 2);
-    if (!args.right.empty() && *layout != StereoLayout::pair)
-      throw UserError(
-          fmt::format("--right gives the right view as a second file; layout {} does not apply", args.layout), 2);
-    plan.still.layout = layout;
   }
-  if (!args.right.empty()) plan.still.right = args.right;
-  plan.still.swap_eyes = args.swap_eyes;
-
+  if (!args.right.empty() && common.layout && *common.layout != StereoLayout::pair)
+    throw UserError(fmt::format("--right gives the right view as a second file; layout {} does not apply", args.layout),
+                    2);
   try {
     validate_fsaa(args.fsaa);
   } catch (const std::invalid_argument& e) {
     throw UserError(e.what(), 2);
   }
-  plan.compositor.fsaa = args.fsaa;
-  plan.compositor.gpu = args.gpu;
+  common.compositor.fsaa = args.fsaa;
+  common.compositor.gpu = args.gpu;
 
-  plan.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
-  const std::string signal_name = args.signal.empty() ? plan.profile.signal : args.signal;
+  common.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
+  const std::string signal_name = args.signal.empty() ? common.profile.signal : args.signal;
   const auto signal = find_signal(signal_name);
   if (!signal) {
     const std::string source =
-        args.signal.empty() ? fmt::format(" (output.signal of profile {})", plan.profile.name) : std::string();
+        args.signal.empty() ? fmt::format(" (output.signal of profile {})", common.profile.name) : std::string();
     throw UserError(fmt::format("unknown signal '{}'{} (use {})", signal_name, source, fmt::join(signal_names(), ", ")),
                     2);
   }
-  plan.signal = *signal;
+  common.signal = *signal;
+  return common;
+}
+
+ConvertPlan plan_convert(const ConvertArgs& args) {
+  ConvertPlan plan;
+  CommonOptions common = parse_common_options(args, true);
+  plan.still.layout = common.layout;
+  if (!args.right.empty()) plan.still.right = args.right;
+  plan.still.swap_eyes = args.swap_eyes;
+  plan.compositor = common.compositor;
+  plan.profile = std::move(common.profile);
+  plan.signal = common.signal;
 
   plan.write.overwrite = args.overwrite;
   plan.write.bits = args.bits;
@@ -116,30 +133,13 @@ void run_convert_video(const ConvertArgs& args) {
   r.input = args.input;
   r.right = args.right;
   r.output = args.output;
-  if (args.layout != "auto") {
-    r.layout = parse_stereo_layout(args.layout);
-    if (!r.layout)
-      throw UserError(
-          fmt::format("unknown layout '{}' (use auto, {})", args.layout, fmt::join(stereo_layout_names(), ", ")), 2);
-    if (*r.layout == StereoLayout::pair && args.right.empty())
-      throw UserError("layout pair needs the right view as a second file (--right FILE)", 2);
-  }
-  if (!args.right.empty() && r.layout != StereoLayout::pair)
-    throw UserError("--right gives the right view as a second file: use it with --layout pair", 2);
+  CommonOptions common = parse_common_options(args, false);
+  r.layout = common.layout;
+  if (!args.right.empty()) r.layout = StereoLayout::pair;  // --right alone means a pair
   r.swap_eyes = args.swap_eyes;
-  try {
-    validate_fsaa(args.fsaa);
-  } catch (const std::invalid_argument& e) {
-    throw UserError(e.what(), 2);
-  }
-  r.compositor.fsaa = args.fsaa;
-  r.compositor.gpu = args.gpu;
-  r.profile = load_profile(args.profile);
-  const std::string signal_name = args.signal.empty() ? r.profile.signal : args.signal;
-  const auto signal = find_signal(signal_name);
-  if (!signal)
-    throw UserError(fmt::format("unknown signal '{}' (use {})", signal_name, fmt::join(signal_names(), ", ")), 2);
-  r.signal = *signal;
+  r.compositor = common.compositor;
+  r.profile = std::move(common.profile);
+  r.signal = common.signal;
   r.encoder.codec = args.codec;
   r.encoder.crf = args.crf;
   r.encoder.overwrite = args.overwrite;

@@ -42,7 +42,6 @@ Image crop(const Image& frame, int x0, int y0, int w, int h) {
 
 double ratio(int w, int h) { return static_cast<double>(w) / static_cast<double>(h); }
 
-
 // The aspect rule of DESIGN.md §6, used only when nothing else says the frame is stereo: a full
 // SBS frame is at least 3:1 (two 16:9 views are 3.56:1), a full TAB frame at most 1:1. Metadata and
 // `lr`/`rl` tokens, which do say stereo, use the looser half/full thresholds of stereo_metadata.hpp.
