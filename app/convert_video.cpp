@@ -358,7 +358,9 @@ class EncodedFileSink final : public FrameSink {
   void write(const PackedFrame& frame) override {
     encoder_->write_video(frame);
     last_end_s_ = frame.pts_seconds + 1.0 / source_.frame_rate();
-    if (carrier_) carrier_->carry_until(*encoder_, frame.pts_seconds + 0.5, end_s_);
+    // Only what starts before this frame ends: the conversion may stop at any frame (--frames, a
+    // damaged input), and audio already written past that point could not be taken back.
+    if (carrier_) carrier_->carry_until(*encoder_, last_end_s_ - 1e-6, end_s_);
     if (generated_rate_ > 0) {
       const auto until = static_cast<std::int64_t>(std::llround(last_end_s_ * generated_rate_));
       if (until > audio_written_) {
