@@ -124,8 +124,11 @@ void run_convert_video(const ConvertArgs& args) {
     if (*r.layout == StereoLayout::pair && args.right.empty())
       throw UserError("layout pair needs the right view as a second file (--right FILE)", 2);
   }
+  // A second file makes a pair, as it does for stills; any other explicit layout contradicts it.
+  if (!args.right.empty() && !r.layout) r.layout = StereoLayout::pair;
   if (!args.right.empty() && r.layout != StereoLayout::pair)
-    throw UserError("--right gives the right view as a second file: use it with --layout pair", 2);
+    throw UserError(fmt::format("--right gives the right view as a second file; layout {} does not apply", args.layout),
+                    2);
   r.swap_eyes = args.swap_eyes;
   try {
     validate_fsaa(args.fsaa);
