@@ -143,6 +143,10 @@ class FileFrameSource final : public StereoFrameSource {
   FileFrameSource(const VideoConvertRequest& r) : path_(r.input), source_(open(r.input, r.allow_network)) {
     if (r.start_s) source_.seek(*r.start_s);
     pending_ = source_.next_frame();
+    if (!pending_ && r.start_s && source_.info().duration_s && *r.start_s >= *source_.info().duration_s)
+      throw UserError(fmt::format("{}: --start {} is past the end of the video ({:.3g} s)", r.input, *r.start_s,
+                                  *source_.info().duration_s),
+                      1);
     if (!pending_) throw UserError(fmt::format("{}: no video frame could be decoded", r.input), 1);
     origin_s_ = source_.info().start_time_s + r.start_s.value_or(0.0);
     LayoutEvidence evidence;
