@@ -202,6 +202,7 @@ TEST(ConvertVideo, EveryLayoutRoutesTheEyes) {
   make_media(dir / "right.mkv", "-f lavfi -i color=c=blue:s=320x180:r=10 -frames:v 6" + h264);
   // Half side-by-side (160x180 per eye in 320x180): only its metadata or its name says so.
   make_media(dir / "meta.mkv", red_blue(160, 180, false) + " -metadata:s:v:0 stereo_mode=left_right");
+  make_media(dir / "meta-rl.mkv", red_blue(160, 180, false) + " -metadata:s:v:0 stereo_mode=right_left");
   make_media(dir / "Movie.2019.HSBS.mkv", red_blue(160, 180, false));
 
   struct Case {
@@ -219,6 +220,8 @@ TEST(ConvertVideo, EveryLayoutRoutesTheEyes) {
       {q(dir / "right.mkv") + " --right " + q(dir / "left.mkv") + " --swap-eyes", "layout pair swapped"},
       {q(dir / "meta.mkv"), "layout sbs-half (metadata"},
       {q(dir / "Movie.2019.HSBS.mkv"), "layout sbs-half (filename"},
+      // Matroska right_left: the first half is the right view.
+      {q(dir / "meta-rl.mkv"), "layout sbs-half swapped (metadata", Tint::blue, Tint::red},
       {q(dir / "wide.mkv") + " --swap-eyes", "layout sbs swapped", Tint::blue, Tint::red},
       {q(dir / "tall.mkv") + " --layout tab --swap-eyes", "layout tab swapped", Tint::blue, Tint::red},
       {q(dir / "frames.mkv") + " --layout alt --swap-eyes", "layout alt swapped", Tint::blue, Tint::red},
