@@ -430,17 +430,20 @@ TEST(ConvertVideo, BadOutputsAndArguments) {
   EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"in.mkv", "small.toml", "taken.mkv"}));
 }
 
-// Ctrl-C in the middle of a long conversion: status 130, one line, nothing left behind.
+// Ctrl-C in the middle of a long conversion: status 130, one line, and the temporary file that was
+// being written (listed just before the signal) removed.
 TEST(ConvertVideo, InterruptLeavesNothing) {
   TempDir dir;
   const auto profile = small_profile(dir);
-  const auto r = run_command(std::string(NELF_BINARY) + " convert synthetic:duration=30,size=320x180 " +
-                             q(dir / "out.mkv") + " --profile " + q(profile) +
-                             " & pid=$!; sleep 2; kill -INT $pid; "
-                             "(sleep 30; kill -KILL $pid) 2>/dev/null & guard=$!; "
-                             "wait $pid; status=$?; kill $guard; echo $status");
-  EXPECT_EQ(r.out, "130\n") << r.err;
-  EXPECT_NE(r.err.find("nelf: interrupted: no output written"), std::string::npos) << r.err;
+  const auto r =
+      run_command(std::string(NELF_BINARY) + " convert synthetic:duration=30,size=320x180 " + q(dir / "out.mkv") +
+                  " --profile " + q(profile) + " & pid=$!; sleep 2; ls -A " + q(dir.path()) +
+                  "; kill -INT $pid; "
+                  "(sleep 30; kill -KILL $pid) 2>/dev/null & guard=$!; "
+                  "wait $pid; status=$?; kill $guard; echo status $status");
+  EXPECT_NE(r.out.find(".out.nelf-"), std::string::npos) << "no temporary file while converting: " << r.out;
+  EXPECT_NE(r.out.find("status 130\n"), std::string::npos) << r.out << r.err;
+  EXPECT_NE(r.err.find("nelf: interrupted: no output written\n"), std::string::npos) << r.err;
   EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"small.toml"}));
 }
 
