@@ -143,6 +143,10 @@ class FileFrameSource final : public StereoFrameSource {
   FileFrameSource(const VideoConvertRequest& r) : path_(r.input), source_(open(r.input, r.allow_network)) {
     if (r.start_s) source_.seek(*r.start_s);
     pending_ = source_.next_frame();
+    if (!pending_ && r.start_s && source_.info().duration_s && *r.start_s >= *source_.info().duration_s)
+      throw UserError(fmt::format("{}: --start {} is past the end of the video ({:.3g} s)", r.input, *r.start_s,
+                                  *source_.info().duration_s),
+                      1);
     if (!pending_) throw UserError(fmt::format("{}: no video frame could be decoded", r.input), 1);
     origin_s_ = source_.info().start_time_s + r.start_s.value_or(0.0);
     LayoutEvidence evidence;
@@ -358,7 +362,9 @@ class EncodedFileSink final : public FrameSink {
   void write(const PackedFrame& frame) override {
     encoder_->write_video(frame);
     last_end_s_ = frame.pts_seconds + 1.0 / source_.frame_rate();
-    if (carrier_) carrier_->carry_until(*encoder_, frame.pts_seconds + 0.5, end_s_);
+    // Only what starts before this frame ends: the conversion may stop at any frame (--frames, a
+    // damaged input), and audio already written past that point could not be taken back.
+    if (carrier_) carrier_->carry_until(*encoder_, last_end_s_ - 1e-6, end_s_);
     if (generated_rate_ > 0) {
       const auto until = static_cast<std::int64_t>(std::llround(last_end_s_ * generated_rate_));
       if (until > audio_written_) {

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# `nelf convert` against its natural peer (DESIGN.md §10): an ffmpeg command that decodes the same
+# file and encodes the same 1280x1470 frame with the same codec settings (libx264, preset medium,
+# crf 18, audio copied). The difference is what nelf adds: layout split, the light-field compositor
+# (GL, llvmpipe without a GPU), frame packing and read-back. Not run by ctest; results go to
+# docs/PERFORMANCE.md.
+#
+# usage: tests/bench/convert_vs_ffmpeg.sh [NELF] [SECONDS] [RUNS]
+#   NELF     the nelf binary (default build/nelf)
+#   SECONDS  clip length at 24 fps (default 5)
+#   RUNS     runs of each command; the median is reported (default 3)
+set -euo pipefail
+nelf=$(realpath "${1:-build/nelf}")
+seconds=${2:-5}
+runs=${3:-3}
+export LP_NUM_THREADS=${LP_NUM_THREADS:-$(nproc)}
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+export MESA_SHADER_CACHE_DIR=$work/shader-cache
+clip=$work/clip.sbs.mkv
+
+# 1080p full side-by-side (two 1920x1080 views in 3840x1080) H.264 with AAC audio.
+ffmpeg -nostdin -hide_banner -loglevel error -y \
+  -f lavfi -i "testsrc2=s=1920x1080:r=24:d=$seconds" \
+  -f lavfi -i "testsrc2=s=1920x1080:r=24:d=$seconds,hue=h=180" \
+  -f lavfi -i "sine=frequency=440:sample_rate=48000:duration=$seconds" \
+  -filter_complex "[0][1]hstack[v]" -map "[v]" -map 2:a \
+  -c:v libx264 -preset veryfast -crf 20 -pix_fmt yuv420p -c:a aac "$clip"
+
+nelf_cmd() { "$nelf" convert "$clip" "$work/nelf.mkv" --profile hmz-t1 --quiet -y; }
+ffmpeg_cmd() {
+  ffmpeg -nostdin -hide_banner -loglevel error -y -i "$clip" \
+    -vf scale=1280:1470 -c:v libx264 -preset medium -crf 18 -pix_fmt yuv420p -c:a copy "$work/ffmpeg.mkv"
+}
+
+# Seconds of wall time for one run of a shell function.
+time_it() {
+  local start end
+  start=$(date +%s.%N)
+  "$1"
+  end=$(date +%s.%N)
+  echo "$end - $start" | bc -l
+}
+median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
+
+nelf_times=() ffmpeg_times=()
+for ((i = 1; i <= runs; i++)); do  # interleaved, so load from other processes hits both alike
+  nelf_times+=("$(time_it nelf_cmd)")
+  ffmpeg_times+=("$(time_it ffmpeg_cmd)")
+  printf 'run %d: nelf %.2f s, ffmpeg %.2f s\n' "$i" "${nelf_times[-1]}" "${ffmpeg_times[-1]}"
+done
+
+frames=$(ffprobe -v error -count_packets -select_streams v:0 -show_entries stream=nb_read_packets -of csv=p=0 \
+  "$work/nelf.mkv")
+size=$(ffprobe -v error -select_streams v:0 -show_entries stream=width,height -of csv=s=x:p=0 "$work/nelf.mkv")
+n=$(median "${nelf_times[@]}")
+f=$(median "${ffmpeg_times[@]}")
+echo "clip: ${seconds} s, 3840x1080 sbs H.264 24 fps; output ${size}, ${frames} frames, libx264 medium crf 18"
+printf 'nelf convert: %.2f s (%.1f fps)\n' "$n" "$(echo "$frames / $n" | bc -l)"
+printf 'ffmpeg      : %.2f s (%.1f fps)\n' "$f" "$(echo "$frames / $f" | bc -l)"
+printf 'ratio       : %.2fx (median of %d runs each)\n' "$(echo "$n / $f" | bc -l)" "$runs"
