@@ -10,47 +10,21 @@
 #include <system_error>
 
 #include "app/commands.hpp"
+#include "compositor/chart_style.hpp"
 #include "hmz_output/image_sink.hpp"
 
 namespace nelf::app {
 
 namespace {
 
-using Colour = std::array<float, 3>;
+using Colour = chart::Rgb;
 
-// Viridis (perceptually uniform, readable in grey and by most colour-blind readers), 9 stops.
-Colour viridis(double t) {
-  static constexpr std::array<std::array<int, 3>, 9> stops{{{68, 1, 84},
-                                                            {71, 44, 122},
-                                                            {59, 81, 139},
-                                                            {44, 113, 142},
-                                                            {33, 144, 141},
-                                                            {39, 173, 129},
-                                                            {92, 200, 99},
-                                                            {170, 220, 50},
-                                                            {253, 231, 37}}};
-  t = std::clamp(t, 0.0, 1.0) * (stops.size() - 1);
-  const std::size_t k = std::min(static_cast<std::size_t>(t), stops.size() - 2);
-  const double a = t - static_cast<double>(k);
-  Colour c;
-  for (int i = 0; i < 3; ++i) c[i] = static_cast<float>(((1 - a) * stops[k][i] + a * stops[k + 1][i]) / 255.0);
-  return c;
-}
-
-// DejaVu Sans from Debian's fonts-dejavu-core (packaging/install-deps.sh); OIIO also searches its own paths.
-std::string find_font() {
-  for (const char* candidate : {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-                                "/usr/share/fonts/TTF/DejaVuSans.ttf", "/usr/share/fonts/dejavu/DejaVuSans.ttf"}) {
-    std::error_code ec;
-    if (std::filesystem::exists(candidate, ec)) return candidate;
-  }
-  return "DejaVuSans";
-}
+using chart::viridis;
 
 class Canvas {
  public:
   Canvas(int width, int height)
-      : buffer_(OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT)), font_(find_font()) {
+      : buffer_(OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT)), font_(chart::font()) {
     OIIO::ImageBufAlgo::fill(buffer_, {1.f, 1.f, 1.f});
   }
   void rectangle(int x0, int y0, int x1, int y1, const Colour& c) {

@@ -1,5 +1,6 @@
 #include "compositor/design_plot.hpp"
 
+#include "compositor/chart_style.hpp"
 #include "hmz_output/image_sink.hpp"
 
 #include <OpenImageIO/imagebuf.h>
@@ -30,33 +31,13 @@ int trade_space_resolution_px(const Profile& profile, double focal_mm, double le
 
 namespace {
 
-using Rgb = std::array<float, 3>;
+using chart::Rgb;
 
 constexpr Rgb kWhite = {1.f, 1.f, 1.f};
 constexpr Rgb kBlack = {0.f, 0.f, 0.f};
 constexpr Rgb kDarkGrey = {0.25f, 0.25f, 0.25f};
 
-// Perceptually uniform, colour-blind safe, readable in greyscale: matplotlib's viridis, sampled at
-// 0, 0.1, …, 1 (sRGB) and interpolated linearly.
-Rgb viridis(double t) {
-  static constexpr std::array<Rgb, 11> stops = {{{0.267f, 0.005f, 0.329f},
-                                                 {0.282f, 0.141f, 0.459f},
-                                                 {0.255f, 0.267f, 0.529f},
-                                                 {0.208f, 0.373f, 0.553f},
-                                                 {0.165f, 0.471f, 0.557f},
-                                                 {0.129f, 0.569f, 0.549f},
-                                                 {0.133f, 0.659f, 0.518f},
-                                                 {0.267f, 0.749f, 0.439f},
-                                                 {0.478f, 0.820f, 0.318f},
-                                                 {0.741f, 0.875f, 0.149f},
-                                                 {0.993f, 0.906f, 0.144f}}};
-  const double x = std::clamp(t, 0.0, 1.0) * 10.0;
-  const auto i = std::min<std::size_t>(static_cast<std::size_t>(x), 9);
-  const float w = static_cast<float>(x - static_cast<double>(i));
-  Rgb c;
-  for (std::size_t k = 0; k < 3; ++k) c[k] = stops[i][k] * (1.f - w) + stops[i + 1][k] * w;
-  return c;
-}
+using chart::viridis;
 
 // A "nice" step (1, 2 or 5 × 10^k) giving roughly `count` intervals over `range`.
 double nice_step(double range, int count) {
@@ -128,18 +109,6 @@ class Canvas {
   int width_, height_;
   std::vector<float> pixels_;
 };
-
-// A font OpenImageIO can render with (Debian: fonts-dejavu-core); the plain name lets OpenImageIO
-// search its own font paths elsewhere. The labels stay ASCII: OpenImageIO 2.4's render_text draws
-// a non-ASCII character such as µ as a wrong glyph.
-std::string plot_font() {
-  for (const char* candidate : {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-                                "/usr/share/fonts/TTF/DejaVuSans.ttf", "/usr/share/fonts/dejavu/DejaVuSans.ttf"}) {
-    std::error_code ec;
-    if (std::filesystem::is_regular_file(candidate, ec)) return candidate;
-  }
-  return "DejaVuSans";
-}
 
 // Text on the finished raster. Every call checks for failure: a missing font must be an error that
 // says what to install, not a picture without labels.
@@ -275,7 +244,7 @@ OIIO::ImageBuf draw_plot(const Profile& profile) {
   OIIO::ImageBuf image = canvas.to_image();
   using OIIO::ImageBufAlgo::TextAlignX;
   using OIIO::ImageBufAlgo::TextAlignY;
-  TextPainter text(image, plot_font());
+  TextPainter text(image, chart::font());
   const std::string name = profile.name.empty() ? std::string("profile") : profile.name;
   text.draw(left, 40, fmt::format("Spatial resolution N_p (Eq. 8, horizontal) over the lens design space: {}", name),
             22);
@@ -306,7 +275,7 @@ OIIO::ImageBuf draw_plot(const Profile& profile) {
     const std::string label = fmt::format("{}: f {:.4g} mm, w_l {:.4g} mm, N_p {} px", name,
                                           profile.lens_array->focal_length_mm, profile.lens_array->pitch_mm, n);
     // Right of the mark unless that would leave the plot area.
-    const auto box = OIIO::ImageBufAlgo::text_size(label, 17, plot_font());
+    const auto box = OIIO::ImageBufAlgo::text_size(label, 17, chart::font());
     const bool flip = mark_x + 22 + box.width() > right;
     text.draw(static_cast<int>(mark_x) + (flip ? -22 : 22), static_cast<int>(mark_y) - 14, label, 17, kWhite,
               flip ? TextAlignX::Right : TextAlignX::Left, TextAlignY::Bottom, 2);
