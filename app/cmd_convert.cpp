@@ -74,11 +74,8 @@ struct CommonOptions {
 
 CommonOptions parse_common_options(const ConvertArgs& args, bool still) {
   CommonOptions common;
-  if (args.layout != "auto") {
-    common.layout = parse_stereo_layout(args.layout);
-    if (!common.layout)
-      throw UserError(
-          fmt::format("unknown layout '{}' (use auto, {})", args.layout, fmt::join(stereo_layout_names(), ", ")), 2);
+  common.layout = parse_layout_option(args.layout);
+  if (common.layout) {
     if (still && *common.layout == StereoLayout::alt)
       throw UserError("layout alt (frame-sequential) needs a video; a still holds one view per frame", 2);
     if (*common.layout == StereoLayout::pair && args.right.empty())
@@ -190,6 +187,14 @@ void run_convert(const ConvertArgs& args) {
 }
 
 }  // namespace
+
+std::optional<StereoLayout> parse_layout_option(const std::string& name) {
+  if (name == "auto") return std::nullopt;
+  const auto layout = parse_stereo_layout(name);
+  if (!layout)
+    throw UserError(fmt::format("unknown layout '{}' (use auto, {})", name, fmt::join(stereo_layout_names(), ", ")), 2);
+  return layout;
+}
 
 void add_convert_command(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();

@@ -171,12 +171,7 @@ void run_simulate(const SimulateArgs& args) {
   check_writable(args.ideal, "--ideal");
   check_writable(args.sweep, "--sweep");
   StillOptions still;
-  if (args.layout != "auto") {
-    still.layout = parse_stereo_layout(args.layout);
-    if (!still.layout)
-      throw UserError(
-          fmt::format("unknown layout '{}' (use auto, {})", args.layout, fmt::join(stereo_layout_names(), ", ")), 2);
-  }
+  still.layout = parse_layout_option(args.layout);
   if (!args.right.empty()) still.right = args.right;
   still.swap_eyes = args.swap_eyes;
   try {

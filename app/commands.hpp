@@ -2,7 +2,11 @@
 // Each `nelf` subcommand lives in its own app/cmd_*.cpp and registers itself here.
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <optional>
 #include <stdexcept>
+#include <string>
+
+#include "inputs/stereo_layout.hpp"
 
 namespace nelf::app {
 
@@ -16,6 +20,10 @@ class UserError : public std::runtime_error {
  private:
   int status_;
 };
+
+// The --layout option of convert and simulate: "auto" (nullopt: detect) or a layout name.
+// Throws UserError (status 2) naming the accepted values.
+std::optional<StereoLayout> parse_layout_option(const std::string& name);
 
 // Adds a subcommand to `app`. The callback it installs is run after parsing; it may throw.
 using CommandRegistrar = void (*)(CLI::App& app);

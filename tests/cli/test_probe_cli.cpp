@@ -183,8 +183,8 @@ TEST(ProbeCli, TruncatedFileStillProbes) {
   const nlohmann::json j = probe_json(dir / "cut.mkv");
   EXPECT_EQ(j["layout"], "sbs-half");
   // Cut before its first frame there is nothing to show: a clean error.
-  write_file(dir / "stub.mkv", bytes.substr(0, 200));
-  const CommandResult r = run_nelf("probe " + shell_quote((dir / "stub.mkv").string()));
+  write_file(dir / "truncated.mkv", bytes.substr(0, 200));
+  const CommandResult r = run_nelf("probe " + shell_quote((dir / "truncated.mkv").string()));
   EXPECT_NE(r.status, 0);
   EXPECT_LT(r.status, 128);
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
