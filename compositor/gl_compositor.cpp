@@ -70,7 +70,7 @@ PrefilterPlan plan_prefilter(const EyeMapping& mapping, int width, int height, i
   return plan;
 }
 
-GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shared_ptr<gl::EglContext> context)
+GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shared_ptr<gl::Context> context)
     : context_(context ? std::move(context) : std::make_shared<gl::EglContext>()),
       profile_(std::move(profile)),
       options_(options) {

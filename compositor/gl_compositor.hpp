@@ -20,6 +20,7 @@
 #include <memory>
 
 #include "compositor/compositor.hpp"
+#include "compositor/gl/context.hpp"
 #include "compositor/gl/egl_context.hpp"
 #include "compositor/gl/objects.hpp"
 #include "compositor/mapping.hpp"
@@ -63,9 +64,10 @@ PrefilterPlan plan_prefilter(const EyeMapping& mapping, int width, int height, i
 
 class GlCompositor final : public Compositor {
  public:
-  // Renders with `context`, or with a new headless context (ContextOptions{}) when it is null.
+  // Renders with `context` (headless EGL, a window's or a KMS surface's), or with a new headless
+  // context (ContextOptions{}) when it is null.
   // Throws std::invalid_argument for a bad fsaa value, gl::GlError when GL is unusable.
-  GlCompositor(Profile profile, CompositorOptions options = {}, std::shared_ptr<gl::EglContext> context = nullptr);
+  GlCompositor(Profile profile, CompositorOptions options = {}, std::shared_ptr<gl::Context> context = nullptr);
   ~GlCompositor() override;
   GlCompositor(const GlCompositor&) = delete;
   GlCompositor& operator=(const GlCompositor&) = delete;
@@ -77,7 +79,7 @@ class GlCompositor final : public Compositor {
   // (fsaa ≥ 1): call once per eye per frame. Leaves the target framebuffer bound.
   void render_eye(Eye eye, const GlTextureView& view, const GlTarget& target);
 
-  const gl::EglContext& context() const { return *context_; }
+  const gl::Context& context() const { return *context_; }
   const Profile& profile() const { return profile_; }
   const CompositorOptions& options() const { return options_; }
   std::array<int, 2> panel() const { return profile_.display.resolution; }
@@ -101,7 +103,7 @@ class GlCompositor final : public Compositor {
   GLuint prefilter(const PrefilterPlan& plan, GLuint view_texture, int view_width, int view_height,
                    PrefilterTargets& targets);
 
-  std::shared_ptr<gl::EglContext> context_;
+  std::shared_ptr<gl::Context> context_;
   Profile profile_;
   CompositorOptions options_;
   gl::VertexArray empty_vertex_array_;

@@ -220,7 +220,7 @@ EglContext::EglContext(const ContextOptions& options) {
   display_ = chosen.display;
   context_ = chosen.context;
   if (const auto* r = glGetString(GL_RENDERER)) renderer_ = reinterpret_cast<const char*>(r);
-  if (device_ == "surfaceless platform") software_ = renderer_.find("llvmpipe") != std::string::npos;
+  if (device_ == "surfaceless platform") software_ = is_software_renderer(renderer_);
 }
 
 EglContext::~EglContext() {
@@ -234,6 +234,12 @@ EglContext::~EglContext() {
 void EglContext::make_current() const {
   if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
     throw GlError("eglMakeCurrent failed (" + egl_error_name(eglGetError()) + ")");
+}
+
+bool is_software_renderer(const std::string& renderer) {
+  for (const char* name : {"llvmpipe", "softpipe", "swrast", "SWR"})
+    if (renderer.find(name) != std::string::npos) return true;
+  return false;
 }
 
 }  // namespace nelf::gl

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "compositor/gl/context.hpp"
+
 namespace nelf::gl {
 
 // No usable EGL/OpenGL, or a GL call failed. what() is one line saying what was tried.
@@ -23,21 +25,21 @@ struct ContextOptions {
 // Owns an EGLContext on an initialised EGLDisplay (shared with other EglContexts on the same
 // device; terminated when the last one goes), current on the creating thread. Not copyable or
 // movable: the GL objects created under it refer to it; hold it by (shared) pointer.
-class EglContext {
+class EglContext final : public Context {
  public:
   explicit EglContext(const ContextOptions& options = {});
-  ~EglContext();
+  ~EglContext() override;
   EglContext(const EglContext&) = delete;
   EglContext& operator=(const EglContext&) = delete;
 
   // Makes the context current on the calling thread (it already is on the creating thread).
-  void make_current() const;
+  void make_current() const override;
 
   // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)" or "NVIDIA H100/PCIe/SSE2".
-  const std::string& renderer() const { return renderer_; }
+  const std::string& renderer() const override { return renderer_; }
   // How the display was obtained, e.g. "EGL device 1 of 2 (software)" or "surfaceless platform".
   const std::string& device() const { return device_; }
-  bool is_software() const { return software_; }
+  bool is_software() const override { return software_; }
 
  private:
   void* display_ = nullptr;  // EGLDisplay

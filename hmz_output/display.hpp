@@ -1,0 +1,86 @@
+#pragma once
+// Live sinks (DESIGN.md §7): a desktop window, fullscreen 1:1 on a monitor, quad-buffer stereo, or
+// KMS scan-out. `nelf play` and `nelf calibrate` render every packed frame with the GL compositor
+// into the display's packed framebuffer (GlCompositor::render_eye at the eye areas of
+// hmz_output/packing), then call present(). Each kind of display is its own file
+// (window_display.*, kms_display.*) with its own factory; this header is the contract between them
+// and the commands.
+#include <epoxy/gl.h>
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "compositor/gl/context.hpp"
+#include "hmz_output/signal.hpp"
+
+namespace nelf {
+
+// One key press, layout-aware: printable keys arrive as the character typed ('+', '[', 'S'),
+// the others by name.
+struct KeyPress {
+  enum class Named { none, space, left, right, up, down, page_up, page_down, escape, enter, tab, backspace };
+  Named named = Named::none;
+  char32_t character = 0;  // set when named == Named::none
+  bool shift = false;
+  bool ctrl = false;
+  bool alt = false;
+
+  static KeyPress of(Named n) { return KeyPress{n, 0, false, false, false}; }
+  static KeyPress of(char32_t c) { return KeyPress{Named::none, c, false, false, false}; }
+  bool is(Named n) const { return named == n; }
+  bool is(char32_t c) const { return named == Named::none && character == c; }
+};
+
+enum class OutputKind { window, fullscreen, kms, quad_buffer };
+
+// Parses "window", "fullscreen", "kms", "quad-buffer"; throws std::invalid_argument listing them.
+OutputKind parse_output_kind(const std::string& name);
+std::string output_kind_name(OutputKind kind);
+
+struct DisplayOptions {
+  OutputKind kind = OutputKind::window;
+  Signal signal;                // packed frame size and (for HDMI signals) timing
+  std::array<int, 2> packed{};  // the packed frame in pixels (signal.packed_width/height of the panel)
+  std::string monitor;          // fullscreen: monitor name to match ("" = the one containing "HMZ")
+  std::string connector;        // kms: connector name, e.g. "HDMI-A-1" ("" = the first connected one
+                                // offering a 3D frame-packing mode)
+  std::string title = "nelf";   // window title
+};
+
+class Display {
+ public:
+  virtual ~Display() = default;
+
+  // The display's GL 4.5 core context, current on the thread that opened the display; give it to
+  // GlCompositor so that render_eye() can draw into packed_framebuffer().
+  virtual std::shared_ptr<gl::Context> context() const = 0;
+  // A framebuffer object of options.packed size (row 0 = the packed frame's top row, as everywhere
+  // in the compositor) holding the frame that present() shows. Never 0.
+  virtual GLuint packed_framebuffer() const = 0;
+  virtual std::array<int, 2> packed_size() const = 0;
+
+  // Shows the packed framebuffer's contents: scaled to fit with its aspect kept (window), 1:1
+  // (fullscreen, kms), or split into the left and right back buffers (quad-buffer). Blocks until
+  // the next vertical blank when vsync() is true. Throws std::runtime_error when the output is lost.
+  virtual void present() = 0;
+  // The refresh rate frames are paced at (the signal's, or the monitor's when it reports one).
+  virtual double refresh_hz() const = 0;
+  // True when present() waits for vblank; otherwise the caller paces frames with a timer.
+  virtual bool vsync() const = 0;
+
+  // Key presses since the last call (also handles the window system's other events).
+  virtual std::vector<KeyPress> poll_events() = 0;
+  // The user closed the window (or the output went away); the caller should stop.
+  virtual bool close_requested() const = 0;
+  // 'f': switch between window and fullscreen where that means anything; returns a line for the
+  // on-screen message (e.g. "fullscreen on HMZ-T1" or "fullscreen needs a monitor named …").
+  virtual std::string toggle_fullscreen() { return "fullscreen not available on this output"; }
+
+  // One line for logs, e.g. "window 1280x1470 on :99 (llvmpipe, no vsync)" or
+  // "KMS HDMI-A-1 1280x1470@60Hz 3D frame packing".
+  virtual std::string description() const = 0;
+};
+
+}  // namespace nelf
