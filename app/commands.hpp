@@ -7,19 +7,12 @@
 #include <string>
 
 #include "inputs/stereo_layout.hpp"
+#include "inputs/user_error.hpp"
 
 namespace nelf::app {
 
-// A problem with how nelf was invoked or with its input; main() prints what() as one line and
-// exits with `status` (2 for bad arguments or profiles, 1 for failed jobs).
-class UserError : public std::runtime_error {
- public:
-  explicit UserError(const std::string& message, int status = 1) : std::runtime_error(message), status_(status) {}
-  int status() const { return status_; }
-
- private:
-  int status_;
-};
+// See inputs/user_error.hpp: main() prints what() as one line and exits with status().
+using nelf::UserError;
 
 // The --layout option of convert and simulate: "auto" (nullopt: detect) or a layout name.
 // Throws UserError (status 2) naming the accepted values.
