@@ -216,7 +216,7 @@ class WindowDisplay final : public Display {
     glfwSetCharCallback(window, on_char);
 
     if (!monitor) fit_to_work_area();
-    glfwShowWindow(window);
+    show(window);
 
     packed_texture_ = gl::make_texture_2d(GL_RGBA8, options.packed[0], options.packed[1]);
     packed_fbo_ = gl::make_framebuffer(packed_texture_);
@@ -332,6 +332,15 @@ class WindowDisplay final : public Display {
     return "quad-buffer: the OpenGL driver offers no stereo visuals (" + why +
            "); quad-buffer stereo needs e.g. an NVIDIA Quadro/RTX with Option \"Stereo\" \"12\" in the X "
            "configuration (Mesa never offers it); use --output fullscreen or --output kms";
+  }
+
+  // Maps the window and waits (up to 2 s) until the X server shows it: GLFW waits only 0.1 s, and a
+  // frame swapped into a window that is not yet viewable is lost.
+  static void show(GLFWwindow* window) {
+    glfwShowWindow(window);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+    while (!glfwGetWindowAttrib(window, GLFW_VISIBLE) && std::chrono::steady_clock::now() < deadline)
+      glfwWaitEventsTimeout(0.01);
   }
 
   // Largest size of the packed aspect that fits the work area of the primary monitor (never larger

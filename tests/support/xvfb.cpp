@@ -54,8 +54,10 @@ XvfbServer::XvfbServer(int width, int height, double timeout_seconds) {
       dup2(null_fd, STDOUT_FILENO);
       dup2(null_fd, STDERR_FILENO);
     }
+    // -noreset: by default the server resets when its last client disconnects, and a test that
+    // opens a second display after closing the first would race that reset.
     execlp("Xvfb", "Xvfb", "-displayfd", fd_text.c_str(), "-screen", "0", screen.c_str(), "-nolisten", "tcp",
-           static_cast<char*>(nullptr));
+           "-noreset", static_cast<char*>(nullptr));
     _exit(127);
   }
   close(write_end);

@@ -8,7 +8,7 @@ namespace nelf::test {
 
 class XvfbServer {
  public:
-  // Starts `Xvfb -displayfd FD -screen 0 WIDTHxHEIGHTx24 -nolisten tcp` and waits (up to
+  // Starts `Xvfb -displayfd FD -screen 0 WIDTHxHEIGHTx24 -nolisten tcp -noreset` and waits (up to
   // `timeout_seconds`) until it reports its display number, i.e. accepts connections.
   // Throws std::runtime_error when Xvfb is missing, exits or does not become ready.
   explicit XvfbServer(int width = 1920, int height = 1600, double timeout_seconds = 10.0);
