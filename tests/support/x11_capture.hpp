@@ -1,0 +1,25 @@
+#pragma once
+// What an X11 window shows, read from the X server (XGetImage): the pixels a user would see, whatever
+// the GL driver does with its front buffer (Mesa's software GLX on Xvfb reads its front buffer as
+// black; the window itself holds the swapped image).
+#include <array>
+#include <vector>
+
+struct GLFWwindow;
+
+namespace nelf::test {
+
+struct WindowCapture {
+  int width = 0, height = 0;
+  std::vector<unsigned char> rgb;  // row 0 = the window's top row
+  std::array<int, 3> at(int x, int y) const {
+    const std::size_t i = (static_cast<std::size_t>(y) * width + x) * 3;
+    return {rgb[i], rgb[i + 1], rgb[i + 2]};
+  }
+};
+
+// Waits for the X server to have drawn everything sent so far (XSync), then reads the window.
+// Throws std::runtime_error when the window cannot be read (e.g. not mapped).
+WindowCapture capture_window(GLFWwindow* window);
+
+}  // namespace nelf::test

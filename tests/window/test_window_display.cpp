@@ -1,0 +1,195 @@
+// The GLFW window outputs on a private Xvfb server: what present() puts on screen (read from the
+// X server), and the errors a user meets when there is no display or no stereo.
+#include <gtest/gtest.h>
+
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include <array>
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "hmz_output/window_display.hpp"
+#include "support/x11_capture.hpp"
+#include "support/xvfb.hpp"
+
+namespace nelf {
+namespace {
+
+using Rgb = std::array<int, 3>;
+
+DisplayOptions frame_packed_options(OutputKind kind) {
+  DisplayOptions options;
+  options.kind = kind;
+  options.signal = *find_signal("hdmi-fp-720p60");
+  options.packed = {options.signal.packed_width(1280), options.signal.packed_height(720)};
+  return options;
+}
+
+// Fills the packed frame's quadrants: top-left red, top-right green, bottom-left blue, bottom-right
+// white (rows counted from the packed frame's top, the compositor's memory convention).
+void draw_quadrants(const Display& display) {
+  const auto [w, h] = display.packed_size();
+  const GLuint fbo = display.packed_framebuffer();
+  glEnable(GL_SCISSOR_TEST);
+  const std::array<std::array<GLfloat, 4>, 4> colours{{{1, 0, 0, 1}, {0, 1, 0, 1}, {0, 0, 1, 1}, {1, 1, 1, 1}}};
+  for (int q = 0; q < 4; ++q) {
+    const int x0 = (q % 2) * (w / 2), y0 = (q / 2) * (h / 2);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
+    glScissor(x0, y0, w / 2, h / 2);
+    glClearNamedFramebufferfv(fbo, GL_COLOR, 0, colours[q].data());
+  }
+  glDisable(GL_SCISSOR_TEST);
+}
+
+test::WindowCapture read_window() { return test::capture_window(glfwGetCurrentContext()); }
+
+constexpr Rgb red{255, 0, 0}, green{0, 255, 0}, blue{0, 0, 255}, white{255, 255, 255}, black{0, 0, 0};
+
+class WindowDisplayTest : public ::testing::Test {
+ protected:
+  test::XvfbServer xvfb_;
+  test::ScopedDisplay display_env_{xvfb_.display_name()};
+};
+
+TEST_F(WindowDisplayTest, ShowsThePackedFrameOneToOneWhenItFitsTopRowAtTheTop) {
+  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  ASSERT_NE(display->packed_framebuffer(), 0u);
+  EXPECT_EQ(display->packed_size(), (std::array<int, 2>{1280, 1470}));
+  draw_quadrants(*display);
+  display->present();
+  const test::WindowCapture screen = read_window();
+  // The 1920x1600 screen has room for the frame 1:1.
+  ASSERT_EQ(screen.width, 1280);
+  ASSERT_EQ(screen.height, 1470);
+  EXPECT_EQ(screen.at(0, 0), red);
+  EXPECT_EQ(screen.at(639, 734), red);
+  EXPECT_EQ(screen.at(640, 0), green);
+  EXPECT_EQ(screen.at(1279, 734), green);
+  EXPECT_EQ(screen.at(0, 735), blue);
+  EXPECT_EQ(screen.at(639, 1469), blue);
+  EXPECT_EQ(screen.at(640, 735), white);
+  EXPECT_EQ(screen.at(1279, 1469), white);
+}
+
+TEST_F(WindowDisplayTest, ScalesToFitAResizedWindowWithBlackBars) {
+  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  GLFWwindow* window = glfwGetCurrentContext();
+  glfwSetWindowSize(window, 1000, 500);
+  // Xvfb has no window manager: the resize is immediate once the server has seen it.
+  int width = 0, height = 0;
+  for (int i = 0; i < 200 && (width != 1000 || height != 500); ++i) {
+    display->poll_events();
+    glfwGetFramebufferSize(window, &width, &height);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_EQ(width, 1000);
+  ASSERT_EQ(height, 500);
+  draw_quadrants(*display);
+  // Mesa notices the new drawable size on the next swap: the first frame after a resize can be lost
+  // (harmless while playing, frames keep coming).
+  display->present();
+  display->present();
+  const test::WindowCapture screen = read_window();
+  // Scale 500/1470: the frame is 435x500, centred, with 282-column bars either side.
+  const int frame_w = 435, x0 = (1000 - frame_w) / 2;
+  EXPECT_EQ(screen.at(10, 250), black);
+  EXPECT_EQ(screen.at(x0 - 2, 250), black);
+  EXPECT_EQ(screen.at(x0 + frame_w + 1, 250), black);
+  EXPECT_EQ(screen.at(990, 250), black);
+  EXPECT_EQ(screen.at(x0 + frame_w / 4, 125), red);
+  EXPECT_EQ(screen.at(x0 + 3 * frame_w / 4, 125), green);
+  EXPECT_EQ(screen.at(x0 + frame_w / 4, 375), blue);
+  EXPECT_EQ(screen.at(x0 + 3 * frame_w / 4, 375), white);
+  EXPECT_EQ(screen.at(x0 + 2, 2), red);
+  EXPECT_EQ(screen.at(x0 + frame_w - 3, 497), white);
+}
+
+TEST_F(WindowDisplayTest, WindowIsSizedToTheWorkAreaKeepingTheAspect) {
+  // A packed frame taller than the 1600-row screen is shrunk to fit, aspect kept.
+  DisplayOptions options = frame_packed_options(OutputKind::window);
+  options.signal = *find_signal("hdmi-fp-1080p24");
+  options.packed = {1920, 2205};
+  auto display = open_window_display(options);
+  int width = 0, height = 0;
+  glfwGetFramebufferSize(glfwGetCurrentContext(), &width, &height);
+  EXPECT_EQ(height, 1600);
+  EXPECT_EQ(width, 1393);  // floor(1920 * 1600 / 2205)
+}
+
+TEST_F(WindowDisplayTest, SoftwareSwapsAreNotVsyncAndTheRefreshIsKnown) {
+  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  EXPECT_TRUE(display->context()->is_software()) << display->context()->renderer();
+  EXPECT_FALSE(display->vsync());
+  EXPECT_GT(display->refresh_hz(), 0.0);
+  EXPECT_FALSE(display->close_requested());
+  EXPECT_TRUE(display->poll_events().empty());
+  const std::string description = display->description();
+  EXPECT_NE(description.find("window 1280x1470 on " + xvfb_.display_name()), std::string::npos) << description;
+  EXPECT_NE(description.find("no vsync"), std::string::npos) << description;
+}
+
+TEST_F(WindowDisplayTest, ClosingTheWindowIsReported) {
+  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  glfwSetWindowShouldClose(glfwGetCurrentContext(), GLFW_TRUE);
+  EXPECT_TRUE(display->close_requested());
+}
+
+TEST_F(WindowDisplayTest, TwoDisplaysInTurnEachGetAWorkingContext) {
+  for (int i = 0; i < 2; ++i) {
+    auto display = open_window_display(frame_packed_options(OutputKind::window));
+    draw_quadrants(*display);
+    display->present();
+    EXPECT_EQ(read_window().at(0, 0), red);
+  }
+}
+
+TEST_F(WindowDisplayTest, QuadBufferOnMesaSaysThereAreNoStereoVisuals) {
+  try {
+    open_window_display(frame_packed_options(OutputKind::quad_buffer));
+    FAIL() << "Mesa offered a stereo visual";
+  } catch (const std::runtime_error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("no stereo visuals"), std::string::npos) << message;
+    EXPECT_NE(message.find("Stereo"), std::string::npos) << message;
+    EXPECT_NE(message.find("--output fullscreen"), std::string::npos) << message;
+    EXPECT_NE(message.find("--output kms"), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+  // A failed open leaves GLFW usable.
+  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  EXPECT_NE(display->packed_framebuffer(), 0u);
+}
+
+TEST(WindowDisplayErrors, NoDisplayVariable) {
+  test::ScopedDisplay no_display("");
+  try {
+    open_window_display(frame_packed_options(OutputKind::window));
+    FAIL() << "opened a window without DISPLAY";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(),
+                 "no display: DISPLAY is not set; run inside a desktop session, under xvfb-run, or use --output kms");
+  }
+}
+
+TEST(WindowDisplayErrors, NoXServerAtDisplay) {
+  test::ScopedDisplay nowhere(":9873");
+  try {
+    open_window_display(frame_packed_options(OutputKind::window));
+    FAIL() << "opened a window on a display without a server";
+  } catch (const std::runtime_error& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind("no display: cannot connect to the X server at DISPLAY=:9873", 0), 0u) << message;
+    EXPECT_NE(message.find("--output kms"), std::string::npos) << message;
+  }
+}
+
+TEST(WindowDisplayErrors, KmsIsNotAWindowOutput) {
+  EXPECT_THROW(open_window_display(frame_packed_options(OutputKind::kms)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace nelf
