@@ -6,6 +6,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "compositor/compositor.hpp"
+#include "compositor/profile.hpp"
+#include "hmz_output/signal.hpp"
 #include "inputs/stereo_layout.hpp"
 #include "inputs/user_error.hpp"
 
@@ -18,6 +21,33 @@ using nelf::UserError;
 // Throws UserError (status 2) naming the accepted values.
 std::optional<StereoLayout> parse_layout_option(const std::string& name);
 
+// The input, layout and rendering options that convert and play share (one parser, one wording).
+struct CommonArgs {
+  std::string input;
+  std::string profile = "hmz-t1";
+  std::string layout = "auto";
+  std::string right;
+  bool swap_eyes = false;
+  std::string signal;  // empty = the profile's output.signal
+  int fsaa = 1;
+  std::optional<int> gpu;
+  bool allow_network = false;
+};
+
+// CommonArgs checked before any input is read: layout, antialiasing, device, profile and signal.
+struct CommonOptions {
+  std::optional<StereoLayout> layout;
+  CompositorOptions compositor;
+  Profile profile;
+  Signal signal;
+};
+
+// Registers INPUT (positional) and the CommonArgs options on `cmd`.
+void add_common_options(CLI::App& cmd, CommonArgs& args);
+// Throws UserError (status 2) for contradictory options and unknown signals, ProfileError for bad
+// profiles. `still`: the input is a still image (refuses layout alt).
+CommonOptions parse_common_options(const CommonArgs& args, bool still);
+
 // Adds a subcommand to `app`. The callback it installs is run after parsing; it may throw.
 using CommandRegistrar = void (*)(CLI::App& app);
 
@@ -26,5 +56,6 @@ void add_design_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
 void add_probe_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
+void add_play_command(CLI::App& app);
 
 }  // namespace nelf::app

@@ -18,6 +18,7 @@ extern "C" {
 }
 
 #include "app/commands.hpp"
+#include "app/interrupt.hpp"
 #include "compositor/gl_compositor.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
@@ -32,33 +33,6 @@ extern "C" {
 namespace nelf::app {
 
 namespace {
-
-// Set by SIGINT/SIGTERM while a conversion runs; every stage polls it.
-std::atomic<bool> interrupted{false};
-extern "C" void on_interrupt(int) { interrupted.store(true); }
-
-// Installs the handlers for the lifetime of the conversion and restores the previous ones.
-class InterruptGuard {
- public:
-  InterruptGuard() {
-    interrupted.store(false);
-    struct sigaction action {};
-    action.sa_handler = on_interrupt;
-    sigemptyset(&action.sa_mask);
-    sigaction(SIGINT, &action, &previous_int_);
-    sigaction(SIGTERM, &action, &previous_term_);
-  }
-  ~InterruptGuard() {
-    sigaction(SIGINT, &previous_int_, nullptr);
-    sigaction(SIGTERM, &previous_term_, nullptr);
-  }
-  InterruptGuard(const InterruptGuard&) = delete;
-  InterruptGuard& operator=(const InterruptGuard&) = delete;
-
- private:
-  struct sigaction previous_int_ {};
-  struct sigaction previous_term_ {};
-};
 
 // Where packed frames go: an encoded file or an image sequence.
 class FrameSink {
