@@ -32,12 +32,6 @@ std::unique_ptr<Display> open_display(const DisplayOptions& options) {
     case OutputKind::window:
     case OutputKind::fullscreen:
     case OutputKind::quad_buffer: {
-      const char* x_display = std::getenv("DISPLAY");
-      if (!x_display || !*x_display)
-        throw UserError(fmt::format("--output {} needs an X display and DISPLAY is not set; run it in the desktop "
-                                    "session, or use --output kms on a text console",
-                                    output_kind_name(options.kind)),
-                        1);
       try {
         return open_window_display(options);
       } catch (const std::exception& e) {
