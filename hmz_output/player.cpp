@@ -334,7 +334,8 @@ class FrameLog {
     if (path.empty()) return;
     file_ = std::fopen(path.c_str(), "w");
     if (!file_) throw UserError(fmt::format("{}: cannot write the frame log", path), 1);
-    std::fputs("refresh,event,pts_s,clock_s,audio_clock_s,shown,repeated,dropped,upload_ms,render_ms,present_ms\n", file_);
+    std::fputs("refresh,event,pts_s,clock_s,audio_clock_s,shown,repeated,dropped,upload_ms,render_ms,present_ms\n",
+               file_);
   }
   ~FrameLog() {
     if (file_) std::fclose(file_);
@@ -436,7 +437,11 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   std::optional<StereoVideoFrame> current;
   std::string message;
   Steady::time_point message_until{};
-  double render_s = refresh_period;  // smoothed time from decision to the end of present()
+  // Time from the decision to the end of present(): the median of the last few renders (the first,
+  // which compiles shaders, does not count), so one slow frame on a loaded machine does not make
+  // the next ones come early.
+  std::deque<double> render_times;
+  double render_s = refresh_period;
   std::int64_t refresh = 0;
   auto next_tick = Steady::now();
 
@@ -574,8 +579,13 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
       }
       present_s = seconds_since(t);
       dirty = false;
-      const double took = seconds_since(decided_at);
-      render_s = started ? 0.8 * render_s + 0.2 * took : took;
+      if (started) {
+        render_times.push_back(seconds_since(decided_at));
+        if (render_times.size() > 9) render_times.pop_front();
+        std::vector<double> sorted(render_times.begin(), render_times.end());
+        std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+        render_s = sorted[sorted.size() / 2];
+      }
       if (!started) {
         started = true;
         if (!paused && !awaiting_seek) clock->set_paused(false);

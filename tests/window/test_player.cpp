@@ -39,13 +39,13 @@ virtual_image_mm = 1000.0
 }
 
 // 2 s at 30 fps, side by side: left view red-ish, right view blue-ish, each with a white box that
-// moves 10 px per frame (the frame number, visible).
+// moves 5 px per frame (the frame number, visible).
 std::filesystem::path make_clip(const test::TempDir& dir) {
   return test::make_media(
       dir / "clip.mp4",
       "-f lavfi -i color=c=0xC03020:s=320x180:r=30:d=2 -f lavfi -i color=c=0x2040C0:s=320x180:r=30:d=2 "
       "-f lavfi -i color=c=white:s=20x60:r=30:d=2 -filter_complex "
-      "\"[2]split[b1][b2];[0][b1]overlay=x='mod(n*10,300)':y=60[l];[1][b2]overlay=x='mod(n*10,300)':y=60[r];"
+      "\"[2]split[b1][b2];[0][b1]overlay=x='mod(n*5,300)':y=60[l];[1][b2]overlay=x='mod(n*5,300)':y=60[r];"
       "[l][r]hstack\" -c:v libx264 -preset ultrafast -pix_fmt yuv420p");
 }
 
