@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "hmz_output/window_display.hpp"
-#include "support/x11_capture.hpp"
+#include "support/x11_window.hpp"
 #include "support/xvfb.hpp"
 
 namespace nelf {
@@ -162,6 +162,132 @@ TEST_F(WindowDisplayTest, QuadBufferOnMesaSaysThereAreNoStereoVisuals) {
   // A failed open leaves GLFW usable.
   auto display = open_window_display(frame_packed_options(OutputKind::window));
   EXPECT_NE(display->packed_framebuffer(), 0u);
+}
+
+// Xvfb's one RandR output is called "screen", its mode is the server's screen size, refresh unknown.
+TEST_F(WindowDisplayTest, FullscreenWithoutAnHmzListsTheMonitors) {
+  try {
+    open_window_display(frame_packed_options(OutputKind::fullscreen));
+    FAIL() << "went fullscreen without an HMZ monitor";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(),
+                 "fullscreen: no monitor name contains \"HMZ\"; connected monitors: screen 1920x1600; pass --monitor "
+                 "NAME");
+  }
+}
+
+TEST_F(WindowDisplayTest, FullscreenOnAMonitorInAnotherModeGivesTheXrandrCommands) {
+  DisplayOptions options = frame_packed_options(OutputKind::fullscreen);
+  options.monitor = "screen";
+  try {
+    open_window_display(options);
+    FAIL() << "went fullscreen on a 1920x1600 monitor";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(),
+                 "fullscreen: monitor screen is in mode 1920x1600, but the hdmi-fp-720p60 signal needs 1280x1470 "
+                 "pixels 1:1; add and select the mode with:\n"
+                 "  xrandr --newmode \"1280x1470_60_fp\" 148.50 1280 1390 1430 1650 1470 1475 1480 1500 +hsync +vsync\n"
+                 "  xrandr --addmode screen 1280x1470_60_fp\n"
+                 "  xrandr --output screen --mode 1280x1470_60_fp");
+  }
+}
+
+// Thin lines, one pixel wide, at packed column 100 and packed row 200: they survive only 1:1.
+void draw_hairlines(const Display& display) {
+  const GLuint fbo = display.packed_framebuffer();
+  const GLfloat black_colour[4] = {0, 0, 0, 1}, white_colour[4] = {1, 1, 1, 1};
+  glClearNamedFramebufferfv(fbo, GL_COLOR, 0, black_colour);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(100, 0, 1, display.packed_size()[1]);
+  glClearNamedFramebufferfv(fbo, GL_COLOR, 0, white_colour);
+  glScissor(0, 200, display.packed_size()[0], 1);
+  glClearNamedFramebufferfv(fbo, GL_COLOR, 0, white_colour);
+  glDisable(GL_SCISSOR_TEST);
+}
+
+class PackedSizeScreenTest : public ::testing::Test {
+ protected:
+  test::XvfbServer xvfb_{1280, 1470};
+  test::ScopedDisplay display_env_{xvfb_.display_name()};
+};
+
+TEST_F(PackedSizeScreenTest, FullscreenShowsThePackedFramePixelForPixel) {
+  DisplayOptions options = frame_packed_options(OutputKind::fullscreen);
+  options.monitor = "SCREEN";
+  auto display = open_window_display(options);
+  EXPECT_NE(display->description().find("fullscreen on screen 1280x1470"), std::string::npos) << display->description();
+  EXPECT_DOUBLE_EQ(display->refresh_hz(), 60.0);  // Xvfb reports no refresh: the signal's
+  draw_hairlines(*display);
+  display->present();
+  const test::WindowCapture screen = read_window();
+  ASSERT_EQ(screen.width, 1280);
+  ASSERT_EQ(screen.height, 1470);
+  EXPECT_EQ(screen.at(100, 50), white);
+  EXPECT_EQ(screen.at(99, 50), black);
+  EXPECT_EQ(screen.at(101, 50), black);
+  EXPECT_EQ(screen.at(700, 200), white);
+  EXPECT_EQ(screen.at(700, 199), black);
+  EXPECT_EQ(screen.at(700, 201), black);
+}
+
+TEST_F(PackedSizeScreenTest, ToggleFullscreenAndBack) {
+  DisplayOptions options = frame_packed_options(OutputKind::window);
+  options.monitor = "screen";
+  auto display = open_window_display(options);
+  EXPECT_EQ(display->toggle_fullscreen(), "fullscreen on screen");
+  EXPECT_NE(display->description().find("fullscreen on screen"), std::string::npos) << display->description();
+  draw_hairlines(*display);
+  display->present();
+  display->present();
+  EXPECT_EQ(read_window().at(100, 50), white);
+  EXPECT_EQ(display->toggle_fullscreen(), "window");
+  EXPECT_EQ(display->description().rfind("window 1280x1470", 0), 0u) << display->description();
+}
+
+TEST_F(WindowDisplayTest, ToggleFullscreenWithoutAnHmzSaysWhyInOneLine) {
+  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  EXPECT_EQ(display->toggle_fullscreen(),
+            "fullscreen: no monitor name contains \"HMZ\"; connected monitors: screen 1920x1600; pass --monitor NAME");
+  EXPECT_EQ(display->description().rfind("window 1280x1470", 0), 0u) << display->description();
+}
+
+std::vector<KeyPress> poll_until(Display& display, std::size_t count) {
+  std::vector<KeyPress> keys;
+  for (int i = 0; i < 200 && keys.size() < count; ++i) {
+    for (const auto& key : display.poll_events()) keys.push_back(key);
+    if (keys.size() < count) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return keys;
+}
+
+TEST_F(WindowDisplayTest, KeysArriveAsTypedCharactersOrByName) {
+  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  GLFWwindow* window = glfwGetCurrentContext();
+  // US layout on Xvfb: '+' is Shift+'=' there, but the key press carries the character typed.
+  for (const char* key : {"plus", "minus", "bracketleft", "bracketright", "s", "space", "Left", "Right", "Up", "Down",
+                          "Escape", "Return", "Page_Up"})
+    test::send_key(window, key, std::string(key) == "plus");
+  test::send_key(window, "q", false, true);
+  const auto keys = poll_until(*display, 14);
+  ASSERT_EQ(keys.size(), 14u);
+  using N = KeyPress::Named;
+  EXPECT_TRUE(keys[0].is(U'+'));
+  EXPECT_TRUE(keys[1].is(U'-'));
+  EXPECT_TRUE(keys[2].is(U'['));
+  EXPECT_TRUE(keys[3].is(U']'));
+  EXPECT_TRUE(keys[4].is(U's'));
+  EXPECT_FALSE(keys[4].shift);
+  EXPECT_TRUE(keys[5].is(N::space));
+  EXPECT_TRUE(keys[6].is(N::left));
+  EXPECT_TRUE(keys[7].is(N::right));
+  EXPECT_TRUE(keys[8].is(N::up));
+  EXPECT_TRUE(keys[9].is(N::down));
+  EXPECT_TRUE(keys[10].is(N::escape));
+  EXPECT_TRUE(keys[11].is(N::enter));
+  EXPECT_TRUE(keys[12].is(N::page_up));
+  EXPECT_TRUE(keys[13].is(U'q'));
+  EXPECT_TRUE(keys[13].ctrl);
+  EXPECT_TRUE(display->poll_events().empty());
 }
 
 TEST(WindowDisplayErrors, NoDisplayVariable) {
