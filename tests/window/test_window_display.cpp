@@ -8,10 +8,14 @@
 
 #include <array>
 #include <chrono>
+#include <cstdlib>
 #include <stdexcept>
 #include <thread>
 #include <vector>
 
+#include "compositor/gl_compositor.hpp"
+#include "compositor/profile.hpp"
+#include "hmz_output/packing.hpp"
 #include "hmz_output/window_display.hpp"
 #include "support/x11_window.hpp"
 #include "support/xvfb.hpp"
@@ -288,6 +292,66 @@ TEST_F(WindowDisplayTest, KeysArriveAsTypedCharactersOrByName) {
   EXPECT_TRUE(keys[13].is(U'q'));
   EXPECT_TRUE(keys[13].ctrl);
   EXPECT_TRUE(display->poll_events().empty());
+}
+
+Image flat(int width, int height, Rgba colour) {
+  Image image(width, height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) image.at(x, y) = colour;
+  return image;
+}
+
+// Mean RGB (0-255) of a rectangle given from the window's top.
+std::array<double, 3> mean(const test::WindowCapture& screen, int x0, int y0, int w, int h) {
+  std::array<double, 3> sum{};
+  for (int y = y0; y < y0 + h; ++y)
+    for (int x = x0; x < x0 + w; ++x)
+      for (int k = 0; k < 3; ++k) sum[k] += screen.at(x, y)[k];
+  for (auto& v : sum) v /= static_cast<double>(w) * h;
+  return sum;
+}
+
+// The path `nelf play` takes: the GL compositor renders both eyes in the window's own (GLX) context
+// straight into the packed framebuffer at the eye areas, then present().
+TEST_F(WindowDisplayTest, TheCompositorRendersIntoThePackedFrameInTheWindowsContext) {
+  const DisplayOptions options = frame_packed_options(OutputKind::window);
+  auto display = open_window_display(options);
+  GlCompositor compositor(load_profile("hmz-t1"), {1, std::nullopt}, display->context());
+  const gl::Texture left = upload_texture(flat(320, 180, {0.f, 1.f, 0.f, 1.f}), GL_RGBA8);
+  const gl::Texture right = upload_texture(flat(320, 180, {1.f, 0.f, 0.f, 1.f}), GL_RGBA8);
+  for (const Eye eye : {Eye::left, Eye::right}) {
+    const auto area = eye_area(options.signal, eye, 1280, 720);
+    ASSERT_TRUE(area);
+    compositor.render_eye(eye, {(eye == Eye::left ? left : right).id(), 320, 180, 0.0},
+                          {display->packed_framebuffer(), area->x, area->y});
+  }
+  display->present();
+  const test::WindowCapture screen = read_window();
+  ASSERT_EQ(screen.height, 1470);
+  const auto top = mean(screen, 0, 0, 1280, 720), gap = mean(screen, 0, 720, 1280, 30),
+             bottom = mean(screen, 0, 750, 1280, 720);
+  EXPECT_GT(top[1], 100.0);  // the left eye's elemental images: green
+  EXPECT_LT(top[0], 5.0);
+  EXPECT_GT(bottom[0], 100.0);  // the right eye's: red
+  EXPECT_LT(bottom[1], 5.0);
+  EXPECT_EQ(gap, (std::array<double, 3>{0, 0, 0}));  // the gap rows stay black
+}
+
+TEST_F(WindowDisplayTest, NoOpenGL45IsAClearError) {
+  // Mesa's override makes the driver offer OpenGL 3.3 only.
+  setenv("MESA_GL_VERSION_OVERRIDE", "3.3", 1);
+  try {
+    open_window_display(frame_packed_options(OutputKind::window));
+    unsetenv("MESA_GL_VERSION_OVERRIDE");
+    FAIL() << "opened a 4.5 context on a 3.3 driver";
+  } catch (const std::runtime_error& e) {
+    unsetenv("MESA_GL_VERSION_OVERRIDE");
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind("OpenGL 4.5 core is not available on this X display (", 0), 0u) << message;
+    EXPECT_NE(message.find("--output kms"), std::string::npos) << message;
+  }
+  auto display = open_window_display(frame_packed_options(OutputKind::window));  // the override is gone
+  EXPECT_NE(display->packed_framebuffer(), 0u);
 }
 
 TEST(WindowDisplayErrors, NoDisplayVariable) {
