@@ -19,6 +19,7 @@
 #include "hmz_output/glfw_monitor_model.hpp"
 #include "hmz_output/monitor_selection.hpp"
 #include "hmz_output/packing.hpp"
+#include "hmz_output/swap_timing.hpp"
 
 namespace nelf {
 
@@ -402,9 +403,8 @@ class WindowDisplay final : public Display {
 
   // Whether glfwSwapBuffers really waits for the vertical blank. A software rasteriser never does
   // (llvmpipe copies the image into the window with XPutImage/MIT-SHM; Xvfb has no vblank at all),
-  // nor a driver without a GLX swap-control extension. Otherwise: interval 1, and a few swaps timed
-  // — they must take about a refresh period each (not just being slow: at least 3/4 of the period
-  // and consistent), else the driver or compositor ignores the interval.
+  // nor a driver without a GLX swap-control extension. Otherwise: interval 1, and six swaps timed
+  // (after two to warm up); swaps_wait_for_vblank judges them. Costs about 8 frames at start-up.
   bool decide_vsync() {
     const bool has_swap_control = glfwExtensionSupported("GLX_EXT_swap_control") ||
                                   glfwExtensionSupported("GLX_MESA_swap_control") ||
@@ -427,10 +427,7 @@ class WindowDisplay final : public Display {
       if (i >= 2) intervals.push_back(std::chrono::duration<double>(now - last).count());  // skip warm-up
       last = now;
     }
-    std::sort(intervals.begin(), intervals.end());
-    const double period = 1.0 / refresh_hz_;
-    const double median = intervals[intervals.size() / 2];
-    const bool waits = median > 0.75 * period && median < 1.5 * period && intervals.front() > 0.5 * period;
+    const bool waits = swaps_wait_for_vblank(intervals, refresh_hz_);
     if (!waits) glfwSwapInterval(0);
     return waits;
   }
