@@ -16,9 +16,10 @@
 
 #include "compositor/gl/egl_context.hpp"
 #include "compositor/gl/objects.hpp"
-#include "hmz_output/glfw_monitor_model.hpp"
+#include "hmz_output/glfw_x11.hpp"
 #include "hmz_output/monitor_selection.hpp"
 #include "hmz_output/packing.hpp"
+#include "hmz_output/swap_timing.hpp"
 
 namespace nelf {
 
@@ -65,6 +66,7 @@ class GlfwLibrary {
                                              display, why, no_display_advice()));
       throw std::runtime_error("GLFW cannot start: " + why);
     }
+    survive_x_connection_loss();
     auto library = std::shared_ptr<GlfwLibrary>(new GlfwLibrary());
     current = library;
     return library;
@@ -255,6 +257,7 @@ class WindowDisplay final : public Display {
   std::array<int, 2> packed_size() const override { return options_.packed; }
 
   void present() override {
+    throw_if_connection_lost();
     GLFWwindow* window = context_->window();
     int fb_width = 0, fb_height = 0;
     glfwGetFramebufferSize(window, &fb_width, &fb_height);
@@ -271,17 +274,20 @@ class WindowDisplay final : public Display {
     }
     gl::check_error("presenting the packed frame");
     glfwSwapBuffers(window);
+    throw_if_connection_lost();
   }
 
   double refresh_hz() const override { return refresh_hz_; }
   bool vsync() const override { return vsync_; }
 
   std::vector<KeyPress> poll_events() override {
+    throw_if_connection_lost();
     glfwPollEvents();
+    throw_if_connection_lost();
     return std::exchange(pending_keys_, {});
   }
 
-  bool close_requested() const override { return glfwWindowShouldClose(context_->window()); }
+  bool close_requested() const override { return x_connection_lost() || glfwWindowShouldClose(context_->window()); }
 
   std::string toggle_fullscreen() override {
     GLFWwindow* window = context_->window();
@@ -318,6 +324,12 @@ class WindowDisplay final : public Display {
   }
 
  private:
+  void throw_if_connection_lost() const {
+    if (x_connection_lost())
+      throw std::runtime_error("lost the connection to the X server at DISPLAY=" + display_name_ +
+                               " (it exited or the session ended); the window is gone");
+  }
+
   [[noreturn]] void throw_creation_error() {
     const std::string why = take_glfw_error();
     if (options_.kind == OutputKind::quad_buffer && last_glfw_error_code == GLFW_FORMAT_UNAVAILABLE)
@@ -402,9 +414,8 @@ class WindowDisplay final : public Display {
 
   // Whether glfwSwapBuffers really waits for the vertical blank. A software rasteriser never does
   // (llvmpipe copies the image into the window with XPutImage/MIT-SHM; Xvfb has no vblank at all),
-  // nor a driver without a GLX swap-control extension. Otherwise: interval 1, and a few swaps timed
-  // — they must take about a refresh period each (not just being slow: at least 3/4 of the period
-  // and consistent), else the driver or compositor ignores the interval.
+  // nor a driver without a GLX swap-control extension. Otherwise: interval 1, and six swaps timed
+  // (after two to warm up); swaps_wait_for_vblank judges them. Costs about 8 frames at start-up.
   bool decide_vsync() {
     const bool has_swap_control = glfwExtensionSupported("GLX_EXT_swap_control") ||
                                   glfwExtensionSupported("GLX_MESA_swap_control") ||
@@ -427,10 +438,7 @@ class WindowDisplay final : public Display {
       if (i >= 2) intervals.push_back(std::chrono::duration<double>(now - last).count());  // skip warm-up
       last = now;
     }
-    std::sort(intervals.begin(), intervals.end());
-    const double period = 1.0 / refresh_hz_;
-    const double median = intervals[intervals.size() / 2];
-    const bool waits = median > 0.75 * period && median < 1.5 * period && intervals.front() > 0.5 * period;
+    const bool waits = swaps_wait_for_vblank(intervals, refresh_hz_);
     if (!waits) glfwSwapInterval(0);
     return waits;
   }

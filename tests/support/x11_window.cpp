@@ -1,4 +1,4 @@
-#include "support/x11_capture.hpp"
+#include "support/x11_window.hpp"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -36,6 +36,30 @@ WindowCapture capture_window(GLFWwindow* window) {
     }
   XDestroyImage(image);
   return capture;
+}
+
+void send_key(GLFWwindow* window, const std::string& keysym, bool shift, bool control) {
+  ::Display* display = glfwGetX11Display();
+  const Window x_window = glfwGetX11Window(window);
+  const KeySym symbol = XStringToKeysym(keysym.c_str());
+  if (symbol == NoSymbol) throw std::runtime_error("send_key: unknown keysym " + keysym);
+  const KeyCode code = XKeysymToKeycode(display, symbol);
+  if (code == 0) throw std::runtime_error("send_key: no key types " + keysym);
+  XKeyEvent event{};
+  event.display = display;
+  event.window = x_window;
+  event.root = DefaultRootWindow(display);
+  event.subwindow = None;
+  event.time = CurrentTime;
+  event.same_screen = True;
+  event.keycode = code;
+  event.state = (shift ? ShiftMask : 0u) | (control ? ControlMask : 0u);
+  for (const int type : {KeyPress, KeyRelease}) {
+    event.type = type;
+    XSendEvent(display, x_window, True, type == KeyPress ? KeyPressMask : KeyReleaseMask,
+               reinterpret_cast<XEvent*>(&event));
+  }
+  XSync(display, False);
 }
 
 }  // namespace nelf::test
