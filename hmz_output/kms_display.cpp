@@ -116,7 +116,7 @@ class KmsContext final : public gl::Context {
  public:
   KmsContext(std::shared_ptr<KmsGpu> gpu, EGLContext context) : gpu_(std::move(gpu)), context_(context) {}
   ~KmsContext() override {
-    eglMakeCurrent(gpu_->egl, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (eglGetCurrentContext() == context_) eglMakeCurrent(gpu_->egl, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(gpu_->egl, context_);
   }
   KmsContext(const KmsContext&) = delete;
@@ -218,10 +218,11 @@ ProbedCard probe_card(const std::string& path, bool from_environment) {
   return card;
 }
 
+// (These only read the current routing: drmModeGetConnectorCurrent, no new EDID probe.)
 // The CRTC to drive `connector_id` with: the one already driving it, else a free one its encoders
 // can use.
 std::optional<std::uint32_t> choose_crtc(int fd, const drmModeRes& resources, std::uint32_t connector_id) {
-  const ConnectorPtr connector(drmModeGetConnector(fd, connector_id));
+  const ConnectorPtr connector(drmModeGetConnectorCurrent(fd, connector_id));
   if (!connector) return std::nullopt;
   if (connector->encoder_id) {
     const EncoderPtr encoder(drmModeGetEncoder(fd, connector->encoder_id));
@@ -230,7 +231,7 @@ std::optional<std::uint32_t> choose_crtc(int fd, const drmModeRes& resources, st
   std::set<std::uint32_t> busy;  // CRTCs other connectors are shown on
   for (int i = 0; i < resources.count_connectors; ++i) {
     if (resources.connectors[i] == connector_id) continue;
-    const ConnectorPtr other(drmModeGetConnector(fd, resources.connectors[i]));
+    const ConnectorPtr other(drmModeGetConnectorCurrent(fd, resources.connectors[i]));
     if (!other || !other->encoder_id) continue;
     const EncoderPtr encoder(drmModeGetEncoder(fd, other->encoder_id));
     if (encoder && encoder->crtc_id) busy.insert(encoder->crtc_id);
@@ -248,7 +249,7 @@ std::optional<std::uint32_t> choose_crtc(int fd, const drmModeRes& resources, st
 std::vector<std::uint32_t> connectors_on_crtc(int fd, const drmModeRes& resources, std::uint32_t crtc_id) {
   std::vector<std::uint32_t> ids;
   for (int i = 0; i < resources.count_connectors; ++i) {
-    const ConnectorPtr c(drmModeGetConnector(fd, resources.connectors[i]));
+    const ConnectorPtr c(drmModeGetConnectorCurrent(fd, resources.connectors[i]));
     if (!c || !c->encoder_id) continue;
     const EncoderPtr encoder(drmModeGetEncoder(fd, c->encoder_id));
     if (encoder && encoder->crtc_id == crtc_id) ids.push_back(c->connector_id);
@@ -372,7 +373,8 @@ void KmsDisplay::init(const DisplayOptions& options) {
 
   // EGL on the GBM platform with a desktop OpenGL 4.5 core context.
   const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-  if (!has_extension(client, "EGL_KHR_platform_gbm") && !has_extension(client, "EGL_MESA_platform_gbm"))
+  if (!has_extension(client, "EGL_EXT_platform_base") ||
+      (!has_extension(client, "EGL_KHR_platform_gbm") && !has_extension(client, "EGL_MESA_platform_gbm")))
     throw KmsError("EGL has no GBM platform (EGL_KHR_platform_gbm); install Mesa's EGL (libegl-mesa0)");
   gpu_->egl = eglGetPlatformDisplayEXT(EGL_PLATFORM_GBM_KHR, gpu_->gbm.get(), nullptr);
   if (gpu_->egl == EGL_NO_DISPLAY || !eglInitialize(gpu_->egl, nullptr, nullptr)) {
