@@ -9,6 +9,7 @@
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
 #include "hmz_output/display.hpp"
+#include "hmz_output/kms_display.hpp"
 #include "hmz_output/player.hpp"
 #include "hmz_output/window_display.hpp"
 #include "inputs/stereo_frame_source.hpp"
@@ -39,10 +40,13 @@ std::unique_ptr<Display> open_display(const DisplayOptions& options) {
       }
     }
     case OutputKind::kms:
-      break;
+      try {
+        return open_kms_display(options);
+      } catch (const std::exception& e) {
+        throw UserError(e.what(), 1);
+      }
   }
-  throw UserError("--output kms is not built into this nelf (no KMS display yet); use --output window or fullscreen",
-                  1);
+  throw UserError("unknown output", 2);
 }
 
 void run_play(const PlayArgs& args) {

@@ -17,6 +17,7 @@
 
 #include "compositor/gl/objects.hpp"
 #include "compositor/gl_compositor.hpp"
+#include "compositor/text_overlay.hpp"
 #include "hmz_output/audio_output.hpp"
 #include "hmz_output/packing.hpp"
 #include "inputs/audio_source.hpp"
@@ -280,6 +281,10 @@ class PackedRenderer {
     gl::check_error("uploading the views");
   }
 
+  // The on-screen message ("" for none), blended into both views before compositing so that it
+  // is seen in focus through the lenses.
+  void set_message(const std::string& text) { overlay_.set_text(text); }
+
   // Both eyes into the display's packed framebuffer; the gap (and any border) black.
   void render(bool swap_eyes) {
     const GLuint fbo = display_.packed_framebuffer();
@@ -290,8 +295,8 @@ class PackedRenderer {
       const auto& origin = origins_[static_cast<int>(eye)];
       if (!origin) continue;
       const int view = static_cast<int>(eye) ^ (swap_eyes ? 1 : 0);
-      compositor_->render_eye(eye, GlTextureView{views_[view].id(), view_w_, view_h_, aspect_},
-                              GlTarget{fbo, origin->first, origin->second});
+      const GlTextureView shown = overlay_.apply(eye, GlTextureView{views_[view].id(), view_w_, view_h_, aspect_});
+      compositor_->render_eye(eye, shown, GlTarget{fbo, origin->first, origin->second});
     }
   }
 
@@ -322,6 +327,7 @@ class PackedRenderer {
   const PlayerOptions& options_;
   Profile profile_;
   std::unique_ptr<GlCompositor> compositor_;
+  TextOverlay overlay_;
   std::array<std::optional<std::pair<int, int>>, 2> origins_;
   std::array<gl::Texture, 2> views_;
   int view_w_ = 0, view_h_ = 0, bits_ = 8;
@@ -446,9 +452,10 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   auto next_tick = Steady::now();
 
   auto say = [&](std::string text) {
-    if (!options.quiet) std::fprintf(stderr, "nelf: %s\n", text.c_str());
     message = std::move(text);
+    renderer.set_message(message);
     message_until = Steady::now() + std::chrono::seconds(2);
+    dirty = true;
   };
   auto seek_by = [&](double delta) {
     const double from = current ? current->pts_s : clock->now();
@@ -561,6 +568,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     }
     if (!message.empty() && Steady::now() > message_until) {
       message.clear();
+      renderer.set_message("");
       dirty = true;
     }
     if (finished) break;
