@@ -6,14 +6,16 @@
 # --log-frames, where the time of each new frame goes: upload of the two views, compositing both
 # eyes, present() (blit to the window and swap). Not run by ctest; results go to docs/PERFORMANCE.md.
 #
-# usage: tests/bench/play_pacing.sh [NELF] [SECONDS] [FSAA]
+# usage: tests/bench/play_pacing.sh [NELF] [SECONDS] [FSAA] [PROFILE]
 #   NELF     the nelf binary (default build/nelf)
 #   SECONDS  clip length (default 10)
 #   FSAA     --fsaa for play (default 1)
+#   PROFILE  the device profile (default hmz-t1)
 set -euo pipefail
 nelf=$(realpath "${1:-build/nelf}")
 seconds=${2:-10}
 fsaa=${3:-1}
+profile=${4:-hmz-t1}
 export LP_NUM_THREADS=${LP_NUM_THREADS:-$(nproc)}
 export SDL_AUDIODRIVER=${SDL_AUDIODRIVER:-dummy}
 
@@ -34,7 +36,7 @@ read -r -t 10 display_number <&"$displayfd"
 export DISPLAY=:$display_number
 
 echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg), LP_NUM_THREADS=$LP_NUM_THREADS"
-echo "command: nelf play CLIP --profile hmz-t1 --signal hdmi-fp-720p60 --fsaa $fsaa --log-frames LOG (DISPLAY=$DISPLAY, SDL_AUDIODRIVER=$SDL_AUDIODRIVER)"
+echo "command: nelf play CLIP --profile $profile --signal hdmi-fp-720p60 --fsaa $fsaa --log-frames LOG (DISPLAY=$DISPLAY, SDL_AUDIODRIVER=$SDL_AUDIODRIVER)"
 printf '| source | frames | shown | repeated | dropped | upload ms | composite ms | present ms | late >1 frame |\n'
 printf '|---|---|---|---|---|---|---|---|---|\n'
 for fps in 24 30 60; do
@@ -47,7 +49,7 @@ for fps in 24 30 60; do
     -filter_complex "[0][1]hstack[v]" -map "[v]" -map 2:a \
     -c:v libx264 -preset veryfast -crf 20 -pix_fmt yuv420p -c:a aac -shortest "$clip"
   log=$work/log$fps.csv
-  summary=$("$nelf" play "$clip" --layout sbs-half --profile hmz-t1 --signal hdmi-fp-720p60 --fsaa "$fsaa" \
+  summary=$("$nelf" play "$clip" --layout sbs-half --profile "$profile" --signal hdmi-fp-720p60 --fsaa "$fsaa" \
     --log-frames "$log" --quiet 2>&1 | tail -1)
   read -r shown repeated dropped < <(echo "$summary" | sed -E 's/.* ([0-9]+) frames shown, ([0-9]+) repeated, ([0-9]+) dropped.*/\1 \2 \3/')
   # Medians over the new frames (the first one compiles shaders and is left out).

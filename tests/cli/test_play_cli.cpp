@@ -165,6 +165,43 @@ TEST_F(PlayCli, InterruptExitsWith130AndTheSummary) {
   EXPECT_NE(r.err.find("nelf: interrupted\n"), std::string::npos) << r.err;
 }
 
+// Keys reach the player: → seeks 10 s forward, q quits with status 0 and the summary.
+TEST_F(PlayCli, ArrowKeySeeksForwardAndQQuits) {
+  const auto clip = make_clip(dir_, "long.mp4", 30, 24, false);
+  const auto log = dir_ / "frames.csv";
+  const auto r = run_command(
+      env() + std::string(NELF_BINARY) + " play " + q(clip) + " --profile " + q(small_profile(dir_)) +
+      " --log-frames " + q(log) +
+      " & pid=$!; (sleep 60; kill -KILL $pid) 2>/dev/null & guard=$!; export DISPLAY=" + xvfb_.display_name() +
+      "; w=$(timeout 20 xdotool search --sync --name '^nelf: ' | head -1); sleep 1.5; xdotool key --window $w Right; "
+      "sleep 1.5; xdotool key --window $w q; wait $pid; status=$?; kill $guard; echo status $status");
+  EXPECT_NE(r.out.find("status 0\n"), std::string::npos) << r.out << r.err;
+  EXPECT_NE(r.err.find("frames shown"), std::string::npos) << r.err;
+  const auto rows = read_log(log);
+  ASSERT_FALSE(rows.empty());
+  double first_after_seek = -1, last = 0;
+  for (const auto& row : rows) {
+    if (row.event != "shown") continue;
+    if (first_after_seek < 0 && row.pts >= 10) first_after_seek = row.pts;
+    last = row.pts;
+  }
+  EXPECT_GE(first_after_seek, 10.0) << "no frame after the seek";
+  EXPECT_LT(first_after_seek, 15.0);
+  EXPECT_LT(last, 20.0) << "q did not stop it";
+}
+
+// A file cut in the middle (the file ending early): what decodes plays, the loss is counted in the
+// summary line, and the end is a clean exit.
+TEST_F(PlayCli, ATruncatedFilePlaysWhatDecodesAndCountsTheLoss) {
+  make_media(dir_ / "whole.mkv", two_colour_input(320, 180, false, 12, 10) + " -c:v libx264 -preset ultrafast -g 1");
+  const std::string bytes = read_file(dir_ / "whole.mkv");
+  write_file(dir_ / "cut.mkv", bytes.substr(0, bytes.size() / 2));
+  const auto r =
+      run_command(env() + NELF_BINARY + " play " + q(dir_ / "cut.mkv") + " --profile " + q(small_profile(dir_)));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("video frames lost to decode errors"), std::string::npos) << r.err;
+}
+
 TEST_F(PlayCli, QuadBufferOnMesaIsAClearError) {
   const auto clip = make_clip(dir_, "clip.mp4", 1, 24, false);
   const auto r = run_command(env() + NELF_BINARY + " play " + q(clip) + " --output quad-buffer");
