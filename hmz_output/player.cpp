@@ -389,7 +389,9 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   PlaybackClock* clock = &system_clock;
   if (!options.audio) {
     result.sound = "--no-audio";
-  } else if (source.has_generated_audio() || source.audio_path().empty()) {
+  } else if (source.has_generated_audio()) {
+    result.sound = "the synthetic clip's tone is not played";
+  } else if (source.audio_path().empty()) {
     result.sound = "no audio stream";
   } else {
     std::optional<AudioSource> audio_source;
@@ -440,6 +442,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
 
   bool paused = false, started = false, calibration = false, swap_eyes = false, dirty = false;
   bool awaiting_seek = false;
+  bool show_while_paused = false;  // a seek while paused shows the first frame at the new place
   std::optional<StereoVideoFrame> current;
   std::string message;
   Steady::time_point message_until{};
@@ -544,16 +547,18 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     std::vector<double> queued = queue.snapshot(end);
     if (awaiting_seek && (!queued.empty() || end)) {
       awaiting_seek = false;
+      show_while_paused = paused;
       if (!paused) clock->set_paused(false);
     }
     bool finished = false;
-    if (!awaiting_seek && !(paused && started)) {
+    if (!awaiting_seek && (!(paused && started) || show_while_paused)) {
       // When this refresh will be seen: after the next vblank, or once rendered and presented.
       const double visible_at = clock->now() + (display.vsync() ? refresh_period : render_s);
       const FrameDecision d = scheduler.decide(visible_at, queued, end);
       if (d.drop > 0 || d.show_front) {
         auto frame = queue.pop(d.drop, d.show_front);
         if (frame) {
+          show_while_paused = false;
           current = std::move(frame);
           const auto t = Steady::now();
           renderer.upload(*current, calibration);

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
 
 #include <cmath>
 #include <map>
@@ -163,6 +165,29 @@ TEST_F(PlayerWindowTest, SwapEyesPutsTheFirstStoredViewOnTheRight) {
   EXPECT_EQ(result.end, PlayEnd::interrupted);
   ASSERT_FALSE(left_means.empty());
   for (const Mean& m : left_means) EXPECT_GT(m.b, m.r + 0.2);
+}
+
+TEST_F(PlayerWindowTest, ClosingTheWindowEndsPlaybackCleanly) {
+  const auto clip = make_clip(dir_);
+  PlayerOptions options;
+  options.profile = small_profile(dir_);
+  options.signal = *find_signal("hdmi-fp-720p60");
+  options.audio = false;
+  options.quiet = true;
+  DisplayOptions display_options;
+  display_options.signal = options.signal;
+  display_options.packed = {options.signal.packed_width(160), options.signal.packed_height(90)};
+  auto display = open_window_display(display_options);
+  int rendered = 0;
+  // What the window manager's close button does to a GLFW window.
+  options.after_render = [&](const Display&, double) {
+    if (++rendered == 3) glfwSetWindowShouldClose(glfwGetCurrentContext(), GLFW_TRUE);
+  };
+  auto source =
+      open_stereo_frame_source(StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
+  const PlayResult result = play(*display, *source, options);
+  EXPECT_EQ(result.end, PlayEnd::window_closed);
+  EXPECT_EQ(result.counters.shown, 3);
 }
 
 }  // namespace
