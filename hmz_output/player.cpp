@@ -121,13 +121,27 @@ class FrameQueue {
   std::exception_ptr error_;
 };
 
-void decode_loop(StereoFrameSource& source, FrameQueue& queue) {
+// The decode thread. When the machine cannot keep up, video must not drift behind the master clock:
+// a frame whose whole display time has already passed when it comes out of the decoder is not
+// queued (uploading and compositing it would only delay the next one), and when decoding itself
+// falls more than kCatchUpLag_s behind, the decoder jumps ahead to the clock. Both count as
+// dropped frames. At least one frame every kMaxSkip_s is queued anyway, so that a machine that
+// is late with every frame still shows something.
+constexpr double kCatchUpLag_s = 1.0;
+constexpr double kCatchUpLead_s = 0.5;
+constexpr double kMaxSkip_s = 0.25;
+
+void decode_loop(StereoFrameSource& source, FrameQueue& queue, const PlaybackClock& clock, double frame_period,
+                 std::atomic<std::int64_t>& dropped) {
   try {
+    auto last_queued = Steady::now();
+    bool queue_next = true;  // the first frame, and the first after any seek
     for (;;) {
       const FrameQueue::Work work = queue.wait_for_work();
       if (work.stop) return;
       if (work.seek_to) {
         source.seek(*work.seek_to);
+        queue_next = true;
         continue;
       }
       auto frame = source.next();
@@ -135,6 +149,23 @@ void decode_loop(StereoFrameSource& source, FrameQueue& queue) {
         queue.set_end(work.generation);
         continue;
       }
+      const double now = clock.now();
+      const double lag = now - frame->pts_s;
+      if (!queue_next && frame_period > 0 && !clock.paused()) {
+        if (lag > kCatchUpLag_s) {
+          const double target = now + kCatchUpLead_s;
+          dropped += 1 + static_cast<std::int64_t>(std::floor((target - frame->pts_s) / frame_period));
+          source.seek(target);
+          queue_next = true;
+          continue;
+        }
+        if (lag > frame_period && seconds_since(last_queued) < kMaxSkip_s) {
+          ++dropped;
+          continue;
+        }
+      }
+      queue_next = false;
+      last_queued = Steady::now();
       queue.push(std::move(*frame), work.generation);
     }
   } catch (...) {
@@ -428,16 +459,23 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   }
   clock->set_paused(true);  // starts with the first frame on screen
 
+  const double refresh_period = 1.0 / display.refresh_hz();
+  const double fps = source.frame_rate();
+  FrameScheduler scheduler(refresh_period, fps > 0 ? 1.0 / fps : 0.0);
   FrameQueue queue(6);
-  std::jthread decoder([&] { decode_loop(source, queue); });
+  std::atomic<std::int64_t> decoder_dropped{0};
+  std::jthread decoder([&] { decode_loop(source, queue, *clock, fps > 0 ? 1.0 / fps : 0.0, decoder_dropped); });
+  // The scheduler's counters plus the frames the decoder skipped to keep up.
+  auto counters = [&] {
+    FrameCounters c = scheduler.counters();
+    c.dropped += decoder_dropped.load();
+    return c;
+  };
   struct StopDecoder {
     FrameQueue& queue;
     ~StopDecoder() { queue.stop(); }
   } stop_decoder{queue};
 
-  const double refresh_period = 1.0 / display.refresh_hz();
-  const double fps = source.frame_rate();
-  FrameScheduler scheduler(refresh_period, fps > 0 ? 1.0 / fps : 0.0);
   const auto duration = source.duration_s();
 
   bool paused = false, started = false, calibration = false, swap_eyes = false, dirty = false;
@@ -609,8 +647,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     }
     if (event)
       log.write(refresh, event, current ? std::optional(current->pts_s) : std::nullopt, clock->now(),
-                audio ? std::optional(audio->now()) : std::nullopt, scheduler.counters(), upload_s, render_only_s,
-                present_s);
+                audio ? std::optional(audio->now()) : std::nullopt, counters(), upload_s, render_only_s, present_s);
     ++refresh;
 
     if (!display.vsync()) {
@@ -625,7 +662,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   decoder.join();
   if (feeder) result.audio_decode_errors = feeder->decode_errors();
   feeder.reset();
-  result.counters = scheduler.counters();
+  result.counters = counters();
   result.video_decode_errors = source.lost_frames();
   return result;
 }
