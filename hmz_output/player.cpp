@@ -121,14 +121,12 @@ class FrameQueue {
   std::exception_ptr error_;
 };
 
-// The decode thread. When the machine cannot keep up, video must not drift behind the master clock:
-// a frame whose whole display time has already passed when it comes out of the decoder is not
-// queued (uploading and compositing it would only delay the next one), and when decoding itself
-// falls more than kCatchUpLag_s behind, the decoder jumps ahead to the clock. Both count as
-// dropped frames. At least one frame every kMaxSkip_s is queued anyway, so that a machine that
-// is late with every frame still shows something.
-constexpr double kCatchUpLag_s = 1.0;
-constexpr double kCatchUpLead_s = 0.5;
+// The decode thread. When the machine cannot keep up, a frame whose whole display time has already
+// passed when it comes out of the decoder is not queued (uploading and compositing it would only
+// delay the next one) and counts as dropped; at least one frame every kMaxSkip_s is queued anyway,
+// so that a machine that is late with every frame still shows something. (Jumping the decoder ahead
+// by seeking was tried and is worse: with the long GOPs of ordinary H.264 every seek decodes from a
+// keyframe far back.)
 constexpr double kMaxSkip_s = 0.25;
 
 void decode_loop(StereoFrameSource& source, FrameQueue& queue, const PlaybackClock& clock, double frame_period,
@@ -149,20 +147,11 @@ void decode_loop(StereoFrameSource& source, FrameQueue& queue, const PlaybackClo
         queue.set_end(work.generation);
         continue;
       }
-      const double now = clock.now();
-      const double lag = now - frame->pts_s;
-      if (!queue_next && frame_period > 0 && !clock.paused()) {
-        if (lag > kCatchUpLag_s) {
-          const double target = now + kCatchUpLead_s;
-          dropped += 1 + static_cast<std::int64_t>(std::floor((target - frame->pts_s) / frame_period));
-          source.seek(target);
-          queue_next = true;
-          continue;
-        }
-        if (lag > frame_period && seconds_since(last_queued) < kMaxSkip_s) {
-          ++dropped;
-          continue;
-        }
+      const double lag = clock.now() - frame->pts_s;
+      if (!queue_next && frame_period > 0 && !clock.paused() && lag > frame_period &&
+          seconds_since(last_queued) < kMaxSkip_s) {
+        ++dropped;
+        continue;
       }
       queue_next = false;
       last_queued = Steady::now();
