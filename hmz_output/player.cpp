@@ -121,25 +121,17 @@ class FrameQueue {
   std::exception_ptr error_;
 };
 
-// The decode thread. When the machine cannot keep up, a frame whose whole display time has already
-// passed when it comes out of the decoder is not queued (uploading and compositing it would only
-// delay the next one) and counts as dropped; at least one frame every kMaxSkip_s is queued anyway,
-// so that a machine that is late with every frame still shows something. (Jumping the decoder ahead
-// by seeking was tried and is worse: with the long GOPs of ordinary H.264 every seek decodes from a
-// keyframe far back.)
-constexpr double kMaxSkip_s = 0.25;
-
-void decode_loop(StereoFrameSource& source, FrameQueue& queue, const PlaybackClock& clock, double frame_period,
-                 std::atomic<std::int64_t>& dropped) {
+// The decode thread: fills the queue, follows seeks. Frames whose time passes while they wait are
+// dropped by the scheduler. (Skipping late frames here as well was measured and is worse when
+// decoding is the bottleneck: each decoded frame is late, so most were thrown away without the
+// decoder catching up; jumping ahead by seeking is worse still with long GOPs.)
+void decode_loop(StereoFrameSource& source, FrameQueue& queue) {
   try {
-    auto last_queued = Steady::now();
-    bool queue_next = true;  // the first frame, and the first after any seek
     for (;;) {
       const FrameQueue::Work work = queue.wait_for_work();
       if (work.stop) return;
       if (work.seek_to) {
         source.seek(*work.seek_to);
-        queue_next = true;
         continue;
       }
       auto frame = source.next();
@@ -147,14 +139,6 @@ void decode_loop(StereoFrameSource& source, FrameQueue& queue, const PlaybackClo
         queue.set_end(work.generation);
         continue;
       }
-      const double lag = clock.now() - frame->pts_s;
-      if (!queue_next && frame_period > 0 && !clock.paused() && lag > frame_period &&
-          seconds_since(last_queued) < kMaxSkip_s) {
-        ++dropped;
-        continue;
-      }
-      queue_next = false;
-      last_queued = Steady::now();
       queue.push(std::move(*frame), work.generation);
     }
   } catch (...) {
@@ -452,14 +436,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   const double fps = source.frame_rate();
   FrameScheduler scheduler(refresh_period, fps > 0 ? 1.0 / fps : 0.0);
   FrameQueue queue(6);
-  std::atomic<std::int64_t> decoder_dropped{0};
-  std::jthread decoder([&] { decode_loop(source, queue, *clock, fps > 0 ? 1.0 / fps : 0.0, decoder_dropped); });
-  // The scheduler's counters plus the frames the decoder skipped to keep up.
-  auto counters = [&] {
-    FrameCounters c = scheduler.counters();
-    c.dropped += decoder_dropped.load();
-    return c;
-  };
+  std::jthread decoder([&] { decode_loop(source, queue); });
   struct StopDecoder {
     FrameQueue& queue;
     ~StopDecoder() { queue.stop(); }
@@ -636,7 +613,8 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     }
     if (event)
       log.write(refresh, event, current ? std::optional(current->pts_s) : std::nullopt, clock->now(),
-                audio ? std::optional(audio->now()) : std::nullopt, counters(), upload_s, render_only_s, present_s);
+                audio ? std::optional(audio->now()) : std::nullopt, scheduler.counters(), upload_s, render_only_s,
+                present_s);
     ++refresh;
 
     if (!display.vsync()) {
@@ -651,7 +629,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   decoder.join();
   if (feeder) result.audio_decode_errors = feeder->decode_errors();
   feeder.reset();
-  result.counters = counters();
+  result.counters = scheduler.counters();
   result.video_decode_errors = source.lost_frames();
   return result;
 }
