@@ -10,7 +10,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <mutex>
 #include <stdexcept>
 #include <vector>
 
@@ -64,7 +63,8 @@ class GlfwLibrary {
       if (why.find("open display") != std::string::npos || why.find("Failed to open") != std::string::npos)
         throw std::runtime_error(fmt::format("no display: cannot connect to the X server at DISPLAY={} ({}); {}",
                                              display, why, no_display_advice()));
-      throw std::runtime_error("GLFW cannot start: " + why);
+      throw std::runtime_error("GLFW cannot start on DISPLAY=" + std::string(display) + ": " + why +
+                               "; check the X session, or use --output kms");
     }
     survive_x_connection_loss();
     auto library = std::shared_ptr<GlfwLibrary>(new GlfwLibrary());
@@ -254,6 +254,10 @@ class WindowDisplay final : public Display {
       context_->make_current();
     } catch (...) {
     }
+    // The window may outlive this display (a compositor still holds context()): no more callbacks here.
+    glfwSetWindowUserPointer(context_->window(), nullptr);
+    glfwSetKeyCallback(context_->window(), nullptr);
+    glfwSetCharCallback(context_->window(), nullptr);
     packed_fbo_.reset();
     packed_texture_.reset();
   }
@@ -472,7 +476,7 @@ class WindowDisplay final : public Display {
 
   static void on_key(GLFWwindow* window, int key, int /*scancode*/, int action, int mods) {
     WindowDisplay* display = self(window);
-    if (action == GLFW_RELEASE) return;
+    if (!display || action == GLFW_RELEASE) return;
     display->last_mods_ = mods;
     KeyPress press;
     if (const auto named = named_key(key)) {
@@ -493,7 +497,7 @@ class WindowDisplay final : public Display {
 
   static void on_char(GLFWwindow* window, unsigned int codepoint) {
     WindowDisplay* display = self(window);
-    if (codepoint == ' ') return;  // reported as Named::space by on_key
+    if (!display || codepoint == ' ') return;  // reported as Named::space by on_key
     KeyPress press = KeyPress::of(static_cast<char32_t>(codepoint));
     press.shift = display->last_mods_ & GLFW_MOD_SHIFT;
     display->pending_keys_.push_back(press);
