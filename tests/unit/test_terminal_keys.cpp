@@ -170,6 +170,17 @@ TEST(TerminalKeys, SignalPathRestoresWhileTheGuardLives) {
   EXPECT_EQ(pty.settings().c_lflag, before.c_lflag);
 }
 
+TEST(TerminalKeys, SignalPathIsDisarmedOnceTheGuardIsGone) {
+  Pty pty;
+  ASSERT_GE(pty.slave, 0) << "no pseudo-terminal available";
+  { RawTerminal raw(pty.slave); }
+  termios changed = pty.settings();
+  changed.c_lflag &= static_cast<tcflag_t>(~ECHO);
+  ASSERT_EQ(tcsetattr(pty.slave, TCSANOW, &changed), 0);
+  restore_terminal_from_signal();  // must not bring back settings saved by a guard that is gone
+  EXPECT_FALSE(pty.settings().c_lflag & ECHO);
+}
+
 TEST(TerminalKeys, NotATerminalReadsNothing) {
   int fds[2];
   ASSERT_EQ(pipe(fds), 0);

@@ -401,6 +401,13 @@ TEST(WindowDisplayErrors, NoXServerAtDisplay) {
   }
 }
 
+TEST(WindowDisplayErrors, QuadBufferNeedsBothEyes) {
+  DisplayOptions options = frame_packed_options(OutputKind::quad_buffer);
+  options.signal = *find_signal("left");
+  options.packed = {1280, 720};
+  EXPECT_THROW(open_window_display(options), std::invalid_argument);
+}
+
 TEST(WindowDisplayErrors, KmsIsNotAWindowOutput) {
   EXPECT_THROW(open_window_display(frame_packed_options(OutputKind::kms)), std::invalid_argument);
 }
