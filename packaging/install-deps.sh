@@ -7,7 +7,7 @@ packages=(
   # toolchain
   build-essential cmake pkg-config git clang-format file dpkg-dev
   # graphics: EGL/OpenGL through epoxy, Mesa's llvmpipe for GPU-less tests, GLFW windows, KMS/GBM
-  libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libgbm-dev libdrm-dev libglfw3-dev
+  libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libgbm-dev libdrm-dev libglfw3-dev libxrandr-dev libx11-dev
   glslang-tools xvfb xauth
   # media: FFmpeg libraries, the ffmpeg CLI for test media and benchmarks, OpenImageIO
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libswresample-dev libavfilter-dev

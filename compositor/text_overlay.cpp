@@ -1,0 +1,145 @@
+#include "compositor/text_overlay.hpp"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "compositor/chart_style.hpp"
+#include "compositor/gl/egl_context.hpp"
+
+namespace nelf {
+
+namespace {
+
+// The font size in view texels, relative to the view's height: the same apparent size at any source
+// resolution.
+constexpr double kFontPerViewHeight = 1.0 / 16.0;
+constexpr int kMinimumFontPx = 8;
+constexpr double kMaximumWidthFraction = 0.9;  // of the view's width
+constexpr double kBoxCentreFromTop = 0.75;     // lower third
+constexpr float kBoxOpacity = 0.6f;
+
+// Formats the output can keep; anything else (sRGB, RGB without alpha, integer) becomes RGBA16F.
+GLenum output_format(GLenum view_format) {
+  switch (view_format) {
+    case GL_RGBA8:
+    case GL_RGBA16:
+    case GL_RGBA16F:
+    case GL_RGBA32F:
+    case GL_RGB10_A2:
+      return view_format;
+    default:
+      return GL_RGBA16F;
+  }
+}
+
+// Displayed width of one view texel relative to its height (1 for square pixels).
+double pixel_aspect(const GlTextureView& view) { return view.aspect() * view.height / static_cast<double>(view.width); }
+
+}  // namespace
+
+TextOverlay::TextOverlay()
+    : program_(gl::make_program("fullscreen.vert", "text_overlay.frag")),
+      vertex_array_(gl::make_vertex_array()),
+      sampler_(gl::make_linear_clamp_sampler()) {}
+
+TextOverlay::~TextOverlay() = default;
+
+void TextOverlay::set_text(std::string text) { text_ = std::move(text); }
+
+const TextOverlay::Label& TextOverlay::label(int font_px) {
+  if (label_.texture && label_.text == text_ && label_.font_px == font_px) return label_;
+  const std::string font = chart::font();
+  const OIIO::ROI extent = OIIO::ImageBufAlgo::text_size(text_, font_px, font);
+  if (!extent.defined())
+    throw std::runtime_error(
+        fmt::format("cannot render the on-screen text with font {} (install fonts-dejavu-core)", font));
+  // A fixed line height from the font size, so that the box does not jump as descenders come and go.
+  const int pad = std::max(2, font_px / 3);
+  const int ascent = std::max(static_cast<int>(std::lround(0.95 * font_px)), -extent.ybegin);
+  const int descent = std::max(static_cast<int>(std::lround(0.25 * font_px)), extent.yend);
+  const int width = extent.width() + 2 * pad, height = ascent + descent + 2 * pad;
+
+  OIIO::ImageBuf image(OIIO::ImageSpec(width, height, 4, OIIO::TypeDesc::FLOAT));
+  const float box[4] = {0.f, 0.f, 0.f, kBoxOpacity}, white[4] = {1.f, 1.f, 1.f, 1.f};
+  if (!OIIO::ImageBufAlgo::fill(image, box) ||
+      !OIIO::ImageBufAlgo::render_text(image, pad - extent.xbegin, pad + ascent, text_, font_px, font, white))
+    throw std::runtime_error("cannot render the on-screen text: " + image.geterror());
+  std::vector<unsigned char> pixels(static_cast<std::size_t>(width) * height * 4);
+  if (!image.get_pixels(OIIO::ROI(0, width, 0, height, 0, 1, 0, 4), OIIO::TypeDesc::UINT8, pixels.data()))
+    throw std::runtime_error("cannot read the on-screen text: " + image.geterror());
+
+  label_.texture = gl::make_texture_2d(GL_RGBA8, width, height);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(label_.texture.id(), 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
+  gl::check_error("uploading the on-screen text");
+  label_.text = text_;
+  label_.font_px = font_px;
+  label_.width = width;
+  label_.height = height;
+  return label_;
+}
+
+GlTextureView TextOverlay::apply(Eye eye, const GlTextureView& view) {
+  EyeTarget& target = eyes_[static_cast<int>(eye)];
+  target.box = {};
+  if (text_.empty() || view.width <= 0 || view.height <= 0) return view;
+
+  GLint view_format = 0;
+  glGetTextureLevelParameteriv(view.texture, 0, GL_TEXTURE_INTERNAL_FORMAT, &view_format);
+  const GLenum format = output_format(static_cast<GLenum>(view_format));
+  if (!target.texture || target.width != view.width || target.height != view.height || target.format != format) {
+    target.fbo.reset();
+    target.texture = gl::make_texture_2d(format, view.width, view.height);
+    target.fbo = gl::make_framebuffer(target.texture);
+    target.width = view.width;
+    target.height = view.height;
+    target.format = format;
+  }
+
+  // Size: from the view's height; smaller when the line would not fit the width.
+  const double aspect = pixel_aspect(view);
+  int font_px = std::max(kMinimumFontPx, static_cast<int>(std::lround(view.height * kFontPerViewHeight)));
+  const Label* text = &label(font_px);
+  const double widest = kMaximumWidthFraction * view.width * aspect;  // in square (label) pixels
+  if (text->width > widest) {
+    font_px = std::max(kMinimumFontPx, static_cast<int>(std::floor(font_px * widest / text->width)));
+    text = &label(font_px);
+  }
+  Box box;
+  box.width = std::min(view.width, std::max(1, static_cast<int>(std::lround(text->width / aspect))));
+  box.height = std::min(view.height, text->height);
+  box.x = (view.width - box.width) / 2;
+  box.y = std::clamp(static_cast<int>(std::lround(kBoxCentreFromTop * view.height - box.height / 2.0)), 0,
+                     view.height - box.height);
+
+  glBindFramebuffer(GL_FRAMEBUFFER, target.fbo.id());
+  glViewport(0, 0, view.width, view.height);
+  glDisable(GL_SCISSOR_TEST);
+  glDisable(GL_BLEND);
+  glUseProgram(program_.id());
+  glProgramUniform2i(program_.id(), glGetUniformLocation(program_.id(), "u_box_origin"), box.x, box.y);
+  glProgramUniform2i(program_.id(), glGetUniformLocation(program_.id(), "u_box_size"), box.width, box.height);
+  glBindTextureUnit(0, view.texture);
+  glBindTextureUnit(1, text->texture.id());
+  // Our sampler on both units: texelFetch of the view then works whatever the view texture's own
+  // filter (a mipmapped filter on a single-level texture would make it incomplete, reading black).
+  glBindSampler(0, sampler_.id());
+  glBindSampler(1, sampler_.id());
+  glBindVertexArray(vertex_array_.id());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindSampler(0, 0);
+  glBindSampler(1, 0);
+  glBindTextureUnit(1, 0);
+  gl::check_error("drawing the on-screen text");
+
+  target.box = box;
+  return GlTextureView{target.texture.id(), view.width, view.height, view.display_aspect};
+}
+
+}  // namespace nelf
