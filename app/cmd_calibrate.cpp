@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "app/calibrate_session.hpp"
 #include "app/commands.hpp"
 #include "compositor/profile.hpp"
 #include "hmz_output/display.hpp"
@@ -107,8 +108,15 @@ void check_save_path(const std::string& path) {
 
 void run_calibrate(const CalibrateArgs& args) {
   if (!is_output_kind(args.output)) return write_pattern_image(args);
+  CalibrateSession session;
+  session.output = parse_output_kind(args.output);
+  session.pattern = args.pattern.empty() ? TestPattern::stripes : parse_pattern_option(args.pattern);
+  session.compositor = compositor_options(args);
+  session.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
+  session.signal = resolve_signal(session.profile, args.signal);
   check_save_path(args.save);
-  throw UserError("interactive calibration: the window display is not merged into this branch yet", 1);
+  session.save = args.save;
+  run_calibrate_session(session);
 }
 
 }  // namespace

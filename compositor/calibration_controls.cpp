@@ -180,6 +180,11 @@ CalibrationStep CalibrationControls::apply(const KeyPress& key) {
     return step;
   }
   if (key.named != Named::none) return step;
+  if (key.ctrl || key.alt) {
+    // Ctrl+C in the window quits as it would in the terminal; other combinations are not ours.
+    step.quit = key.ctrl && (key.character == U'c' || key.character == U'q');
+    return step;
+  }
   switch (key.character) {
     case U'r':
       return rotate(-rotation_step_deg);
@@ -208,6 +213,14 @@ CalibrationStep CalibrationControls::apply(const KeyPress& key) {
       static constexpr TestPattern patterns[] = {TestPattern::stripes, TestPattern::grid, TestPattern::snellen,
                                                  TestPattern::white};
       const TestPattern next = patterns[key.character - U'1'];
+      if (next == TestPattern::snellen) {
+        try {
+          snellen_letter_height_px(pattern_geometry(profile_), 20);
+        } catch (const TestPatternError&) {
+          step.message = "no Snellen chart: the screen size is unknown";
+          return step;
+        }
+      }
       step.pattern_changed = next != pattern_;
       pattern_ = next;
       step.message = fmt::format("pattern {}", test_pattern_name(pattern_));

@@ -12,7 +12,7 @@
 //   [ / ]        IPD -/+ 0.5 mm                                viewing.ipd_mm
 //   d / D        prescription -/+ 0.25 D                       correction.prescription_diopters
 //   1 2 3 4      stripes, grid, Snellen chart, white
-//   w            save now;  h  help;  q / Esc  quit
+//   w            save now;  h  help (each press the next line);  q / Esc / Ctrl+C  quit
 #include <string>
 #include <vector>
 

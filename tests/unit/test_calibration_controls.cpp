@@ -138,6 +138,10 @@ TEST(CalibrationControls, StockProfileHasNoPitchOrGap) {
   EXPECT_EQ(step.message, "pitch scale: this profile has no lens array");
   step = c.apply(key(U'G'));
   EXPECT_FALSE(step.profile_changed);
+  step = c.apply(key(U'3'));
+  EXPECT_FALSE(step.pattern_changed);
+  EXPECT_EQ(c.pattern(), TestPattern::grid);
+  EXPECT_EQ(step.message, "no Snellen chart: the screen size is unknown");
   step = c.apply(key(U'R'));
   EXPECT_TRUE(step.profile_changed);
   EXPECT_EQ(c.profile().eye_calibration(Eye::right).rotation_deg, 0.05);
@@ -161,6 +165,12 @@ TEST(CalibrationControls, PatternsSaveHelpQuit) {
   EXPECT_TRUE(c.apply(key(U'h')).help);
   EXPECT_TRUE(c.apply(key(U'q')).quit);
   EXPECT_TRUE(c.apply(key(Named::escape)).quit);
+  KeyPress ctrl_c = key(U'c');
+  ctrl_c.ctrl = true;
+  EXPECT_TRUE(c.apply(ctrl_c).quit);
+  KeyPress ctrl_r = key(U'r');
+  ctrl_r.ctrl = true;
+  EXPECT_FALSE(c.apply(ctrl_r).profile_changed);
   step = c.apply(key(U'x'));
   EXPECT_FALSE(step.profile_changed || step.pattern_changed || step.quit || step.save);
   EXPECT_EQ(step.message, "key 'x' does nothing (h: help)");
