@@ -6,7 +6,9 @@
 #include <chrono>
 #include <csignal>
 #include <memory>
+#include <optional>
 #include <thread>
+#include <utility>
 
 #include "app/commands.hpp"
 #include "compositor/calibration_controls.hpp"
@@ -77,10 +79,10 @@ struct PatternTextures {
   int width = 0, height = 0;
   double aspect = 0.0;
 
-  void upload(TestPattern pattern, const Profile& profile) {
+  void upload(TestPattern pattern, const PatternGeometry& geometry) {
     StereoPair views;
     try {
-      views = make_test_pattern(pattern, pattern_geometry(profile));
+      views = make_test_pattern(pattern, geometry);
     } catch (const TestPatternError& e) {
       throw UserError(fmt::format("pattern {}: {}", test_pattern_name(pattern), e.what()), 2);
     }
@@ -100,7 +102,7 @@ class Session {
         display_(open_display(s)),
         controls_(s.profile, s.pattern, 16.0 / 9.0),
         compositor_(std::make_unique<GlCompositor>(s.profile, s.compositor, display_->context())) {
-    patterns_.upload(controls_.pattern(), controls_.profile());
+    upload_pattern();
   }
 
   void run() {
@@ -114,11 +116,23 @@ class Session {
     bool dirty = true;
     while (!interrupted.load() && !display_->close_requested()) {
       bool quit = false;
+      // Keys arrive in batches (key repeat, fast typing): the compositor and the pattern are
+      // rebuilt once per batch, for the last state.
+      bool profile_changed = false, pattern_changed = false;
       for (const KeyPress& key : display_->poll_events()) {
-        dirty |= handle(key, quit);
-        if (quit) break;
+        const CalibrationStep step = handle(key);
+        if ((quit = step.quit)) break;
+        profile_changed |= step.profile_changed;
+        pattern_changed |= step.pattern_changed;
+        dirty |= step.profile_changed || step.pattern_changed || !step.message.empty() || step.save || step.help;
       }
       if (quit) break;
+      if (profile_changed) {
+        // The mapping follows the profile: a new compositor (its programs come from Mesa's shader
+        // cache or the driver's), and the pattern drawn again where its geometry changed.
+        compositor_ = std::make_unique<GlCompositor>(controls_.profile(), settings_.compositor, display_->context());
+      }
+      if (profile_changed || pattern_changed) upload_pattern();
       const auto now = std::chrono::steady_clock::now();
       if (!overlay_.text().empty() && now >= message_until_) {
         overlay_.set_text("");
@@ -146,32 +160,27 @@ class Session {
   }
 
  private:
-  // Returns whether the frame must be rendered again.
-  bool handle(const KeyPress& key, bool& quit) {
+  // Applies one key; says on screen what it did, saves on w.
+  CalibrationStep handle(const KeyPress& key) {
     const CalibrationStep step = controls_.apply(key);
-    if (step.quit) {
-      quit = true;
-      return false;
-    }
-    if (step.profile_changed) {
-      // The mapping and the patterns' sizes follow the profile: a new compositor (cheap: its
-      // programs come from the shader cache) and the pattern drawn again for the new geometry.
-      compositor_ = std::make_unique<GlCompositor>(controls_.profile(), settings_.compositor, display_->context());
-    }
-    if (step.profile_changed || step.pattern_changed) patterns_.upload(controls_.pattern(), controls_.profile());
+    if (step.quit) return step;
     std::string message = step.message;
-    if (step.save) {
-      if (settings_.save.empty())
-        message = "nothing saved: start with --save FILE.toml";
-      else
-        message = save();
-    }
+    if (step.save) message = settings_.save.empty() ? "nothing saved: start with --save FILE.toml" : save();
     if (step.help) {
       const auto& lines = CalibrationControls::help_lines();
       message = lines[help_line_++ % lines.size()];
     }
     if (!message.empty()) show(message);
-    return step.profile_changed || step.pattern_changed || !message.empty();
+    return step;
+  }
+
+  // Draws the pattern again when it or its geometry (screen size and distance, display pixel
+  // footprint) changed; a shift or rotation alone leaves it as it is.
+  void upload_pattern() {
+    const PatternGeometry geometry = pattern_geometry(controls_.profile());
+    if (uploaded_ && geometry == uploaded_->first && controls_.pattern() == uploaded_->second) return;
+    patterns_.upload(controls_.pattern(), geometry);
+    uploaded_ = {geometry, controls_.pattern()};
   }
 
   void show(const std::string& message) {
@@ -208,6 +217,7 @@ class Session {
   std::unique_ptr<GlCompositor> compositor_;
   TextOverlay overlay_;
   PatternTextures patterns_;
+  std::optional<std::pair<PatternGeometry, TestPattern>> uploaded_;
   std::chrono::steady_clock::time_point message_until_;
   std::size_t help_line_ = 0;
 };

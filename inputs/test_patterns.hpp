@@ -46,6 +46,7 @@ struct PatternGeometry {
   int stripe_period_px = 8;           // one white and one black stripe
   int grid_spacing_px = 120;
   int line_width_px = 1;
+  friend bool operator==(const PatternGeometry&, const PatternGeometry&) = default;
 };
 
 // The geometry of `profile`'s virtual screen for views of `width`×`height` (display aspect
