@@ -61,6 +61,7 @@ std::unique_ptr<Display> open_display(const CalibrateSession& s) {
   const auto panel = s.profile.display.resolution;
   options.packed = {s.signal.packed_width(panel[0]), s.signal.packed_height(panel[1])};
   options.title = "nelf calibrate (h: help)";
+  options.monitor = s.monitor;
   if (s.output == OutputKind::kms)
     throw UserError(
         "--output kms: KMS output is not available to nelf calibrate in this build; use --output window or "

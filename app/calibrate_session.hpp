@@ -17,7 +17,8 @@ struct CalibrateSession {
   Signal signal;
   TestPattern pattern = TestPattern::stripes;
   CompositorOptions compositor;
-  std::string save;  // .toml path written on w and at the end ("" = nowhere)
+  std::string monitor;  // fullscreen: a name to match ("" = the one containing "HMZ")
+  std::string save;     // .toml path written on w and at the end ("" = nowhere)
 };
 
 // Runs until q/Esc, the window is closed or SIGINT/SIGTERM; saves to session.save (when given) on

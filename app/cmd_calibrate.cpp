@@ -25,6 +25,7 @@ struct CalibrateArgs {
   std::string profile = "hmz-t1";
   std::string output = "window";
   std::string save;
+  std::string monitor;
   std::string pattern;
   std::string signal;
   int fsaa = 1;
@@ -116,6 +117,7 @@ void run_calibrate(const CalibrateArgs& args) {
   session.signal = resolve_signal(session.profile, args.signal);
   check_save_path(args.save);
   session.save = args.save;
+  session.monitor = args.monitor;
   run_calibrate_session(session);
 }
 
@@ -143,6 +145,8 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--output", args->output,
                   "window, fullscreen, kms or quad-buffer; or an image file (.png, .tif, .exr, .jpg) for --pattern")
       ->capture_default_str();
+  cmd->add_option("--monitor", args->monitor,
+                  "fullscreen: the monitor whose name contains this (default: one containing \"HMZ\")");
   cmd->add_option("--save", args->save, "Write the adjusted profile to this .toml file (w, and when quitting)");
   cmd->add_option("--pattern", args->pattern,
                   fmt::format("Pattern: {} (the first one shown; required with an image --output)",

@@ -10,9 +10,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "compositor/mapping.hpp"
 #include "compositor/profile.hpp"
@@ -160,6 +162,51 @@ TEST_F(CalibrateWindowTest, WritesOnWAndStartsFromTheGivenProfile) {
   ASSERT_NE(first, std::string::npos) << out;
   EXPECT_NE(out.find(line, first + 1), std::string::npos) << out;
   EXPECT_EQ(load_profile(saved.string()).viewing.ipd_mm, 59.5);
+}
+
+TEST_F(CalibrateWindowTest, TheWindowShowsWhatTheHeadlessPatternWrites) {
+  // The interactive path (pattern textures, render_eye into the display's packed framebuffer at
+  // the eye areas) and the headless one (compose, pack_eyes, image file) give the same frame.
+  NelfProcess nelf("calibrate --pattern grid", dir_ / "out.txt", dir_ / "err.txt");
+  const std::string window = find_window(nelf);
+  ASSERT_FALSE(window.empty()) << test::read_file(dir_ / "err.txt");
+  const auto geometry = run_command("xdotool getwindowgeometry --shell " + window);
+  int x = -1, y = -1, width = 0, height = 0;
+  for (const auto& [key, value] : {std::pair{"X=", &x}, {"Y=", &y}, {"WIDTH=", &width}, {"HEIGHT=", &height}}) {
+    const auto at = geometry.out.find(std::string("\n") + key);
+    ASSERT_NE(at, std::string::npos) << geometry.out;
+    *value = std::stoi(geometry.out.substr(at + 1 + std::string(key).size()));
+  }
+  ASSERT_EQ(width, 1280);  // the 1920x1600 screen holds the packed frame 1:1
+  ASSERT_EQ(height, 1470);
+  // The start message ("h: keys  q: quit") is on screen for 2.5 s.
+  std::this_thread::sleep_for(std::chrono::milliseconds(3000));
+  const auto shown = dir_ / "shown.png";
+  auto r = run_command(
+      fmt::format("ffmpeg -loglevel error -f x11grab -draw_mouse 0 -video_size {}x{} -i {}+{},{} -frames:v 1 {}", width,
+                  height, xvfb_.display_name(), x, y, shell_quote(shown.string())));
+  ASSERT_EQ(r.status, 0) << r.err;
+  keys(window, "q");
+  ASSERT_TRUE(nelf.wait(std::chrono::seconds(20)));
+
+  const auto written = dir_ / "written.png";
+  r = run_command(shell_quote(NELF_BINARY) + " calibrate --pattern grid --output " + shell_quote(written.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto a = test::read_back(shown), b = test::read_back(written);
+  ASSERT_EQ(a.width, b.width);
+  ASSERT_EQ(a.height, b.height);
+  double difference = 0.0, lit = 0.0;
+  for (int yy = 0; yy < a.height; ++yy)
+    for (int xx = 0; xx < a.width; ++xx)
+      for (int c = 0; c < 3; ++c) {
+        difference += std::abs(a.at(xx, yy, c) - b.at(xx, yy, c));
+        lit += b.at(xx, yy, c);
+      }
+  const double pixels = 3.0 * a.width * a.height;
+  EXPECT_GT(lit / pixels, 0.05);              // there is a pattern to compare
+  EXPECT_LT(difference / pixels, 2.0 / 255);  // 8-bit view textures in the window, 16-bit float headless
+  for (int yy = 720; yy < 750; ++yy)          // the gap rows stay black in the window too
+    for (int xx = 0; xx < a.width; xx += 7) EXPECT_EQ(a.at(xx, yy, 0) + a.at(xx, yy, 1) + a.at(xx, yy, 2), 0.f);
 }
 
 TEST(CalibrateWindowErrors, NoDisplayIsOneLineAndNothingSaved) {
