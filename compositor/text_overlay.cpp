@@ -119,7 +119,16 @@ GlTextureView TextOverlay::apply(Eye eye, const GlTextureView& view) {
                      view.height - box.height);
 
   glBindFramebuffer(GL_FRAMEBUFFER, target.fbo.id());
-  glViewport(0, 0, view.width, view.height);
+  if (format == static_cast<GLenum>(view_format)) {
+    // Same format: copy the view as it is (a memory copy, several times cheaper than a full-view
+    // pass on llvmpipe) and draw only the box; the shader addresses texels by window position, so a
+    // viewport on the box is all it needs.
+    glCopyImageSubData(view.texture, GL_TEXTURE_2D, 0, 0, 0, 0, target.texture.id(), GL_TEXTURE_2D, 0, 0, 0, 0,
+                       view.width, view.height, 1);
+    glViewport(box.x, box.y, box.width, box.height);
+  } else {
+    glViewport(0, 0, view.width, view.height);  // converts the whole view to the output's format
+  }
   glDisable(GL_SCISSOR_TEST);
   glDisable(GL_BLEND);
   glUseProgram(program_.id());

@@ -34,8 +34,10 @@ class TextOverlay {
   // `view` with the text in a box: light on a translucent dark box, centred horizontally in the lower
   // third, its cap height 1/20 of the view's height (so it looks the same size at any source
   // resolution; narrowed to fit the width). Returns `view` itself when the text is empty; otherwise a
-  // texture of the view's size and format, owned by the overlay and valid until the next apply() for
-  // the same eye. Eyes have separate textures, so both can be prepared before rendering either.
+  // texture of the view's size and format (RGBA8/16/16F/32F, RGB10_A2: the view copied, then only the
+  // box drawn: ~2.5 ms for 1920x1080 on llvmpipe; other formats: one pass into RGBA16F), owned by the
+  // overlay and valid until the next apply() for the same eye. Eyes have separate textures, so both
+  // can be prepared before rendering either.
   // Throws gl::GlError when GL fails, std::runtime_error when the text cannot be rendered (no font).
   GlTextureView apply(Eye eye, const GlTextureView& view);
 

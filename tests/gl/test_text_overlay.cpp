@@ -2,6 +2,7 @@
 // view's height, and leaves the view alone when there is no text.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -112,6 +113,39 @@ TEST_F(TextOverlayTest, AnamorphicViewsGetANarrowerBoxInTexels) {
   const int square = overlay.box(Eye::left).width;
   overlay.apply(Eye::left, {texture.id(), 480, 270, 2.0 * 480.0 / 270.0});
   EXPECT_NEAR(overlay.box(Eye::left).width, square / 2.0, 1.0);
+}
+
+TEST_F(TextOverlayTest, AViewFormatItCannotCopyIsConvertedWhole) {
+  // RGB8 (no alpha): the output is RGBA16F, written by one pass over the whole view.
+  const Image chart = test::photo_chart(160, 90);
+  gl::Texture texture = gl::make_texture_2d(GL_RGB8, 160, 90);
+  std::vector<float> rgb;
+  for (const Rgba& p : chart.pixels()) rgb.insert(rgb.end(), {p.r, p.g, p.b});
+  glTextureSubImage2D(texture.id(), 0, 0, 0, 160, 90, GL_RGB, GL_FLOAT, rgb.data());
+  TextOverlay overlay;
+  overlay.set_text("grid");
+  const GlTextureView shown = overlay.apply(Eye::left, {texture.id(), 160, 90, 0.0});
+  GLint format = 0;
+  glGetTextureLevelParameteriv(shown.texture, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
+  EXPECT_EQ(format, GL_RGBA16F);
+  const auto before = texture_pixels(texture.id(), 160, 90), after = texture_pixels(shown.texture, 160, 90);
+  const TextOverlay::Box box = overlay.box(Eye::left);
+  double outside_difference = 0;
+  int changed_inside = 0;
+  for (int y = 0; y < 90; ++y)
+    for (int x = 0; x < 160; ++x) {
+      const bool inside = x >= box.x && x < box.x + box.width && y >= box.y && y < box.y + box.height;
+      for (int k = 0; k < 3; ++k) {
+        const std::size_t i = (static_cast<std::size_t>(y) * 160 + x) * 4 + k;
+        const double d = std::abs(before[i] - after[i]);
+        if (inside)
+          changed_inside += d > 0.01;
+        else
+          outside_difference = std::max(outside_difference, d);
+      }
+    }
+  EXPECT_LT(outside_difference, 1e-3);  // half-float rounding of 8-bit values only
+  EXPECT_GT(changed_inside, box.width * box.height);
 }
 
 TEST_F(TextOverlayTest, EmptyTextPassesTheViewThrough) {

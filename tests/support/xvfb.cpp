@@ -111,6 +111,13 @@ XvfbServer::~XvfbServer() {
   }
 }
 
+void XvfbServer::kill_now() {
+  if (pid_ <= 0) return;
+  kill(pid_, SIGKILL);
+  reap_within(pid_, 5.0);
+  pid_ = -1;
+}
+
 ScopedDisplay::ScopedDisplay(const std::string& display) {
   if (const char* previous = std::getenv("DISPLAY")) {
     had_previous_ = true;

@@ -17,6 +17,9 @@ class XvfbServer {
   XvfbServer(const XvfbServer&) = delete;
   XvfbServer& operator=(const XvfbServer&) = delete;
 
+  // Kills the server at once (SIGKILL), as when an X session ends under a running program.
+  void kill_now();
+
   // ":N", for setenv("DISPLAY", …) or a child's environment.
   const std::string& display_name() const { return display_name_; }
 

@@ -354,6 +354,30 @@ TEST_F(WindowDisplayTest, NoOpenGL45IsAClearError) {
   EXPECT_NE(display->packed_framebuffer(), 0u);
 }
 
+TEST_F(WindowDisplayTest, LosingTheXServerIsAnExceptionNotAnExit) {
+  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  display->present();
+  xvfb_.kill_now();
+  EXPECT_THROW(
+      {
+        for (int i = 0; i < 10; ++i) {  // the loss shows on the first request that reaches the socket
+          display->poll_events();
+          display->present();
+        }
+      },
+      std::runtime_error);
+  EXPECT_TRUE(display->close_requested());
+  display.reset();  // closing after the loss must not crash either
+
+  // And a later display on another server works.
+  test::XvfbServer another;
+  test::ScopedDisplay use_it(another.display_name());
+  auto next = open_window_display(frame_packed_options(OutputKind::window));
+  draw_quadrants(*next);
+  next->present();
+  EXPECT_EQ(read_window().at(0, 0), red);
+}
+
 TEST(WindowDisplayErrors, NoDisplayVariable) {
   test::ScopedDisplay no_display("");
   try {
@@ -375,6 +399,13 @@ TEST(WindowDisplayErrors, NoXServerAtDisplay) {
     EXPECT_EQ(message.rfind("no display: cannot connect to the X server at DISPLAY=:9873", 0), 0u) << message;
     EXPECT_NE(message.find("--output kms"), std::string::npos) << message;
   }
+}
+
+TEST(WindowDisplayErrors, QuadBufferNeedsBothEyes) {
+  DisplayOptions options = frame_packed_options(OutputKind::quad_buffer);
+  options.signal = *find_signal("left");
+  options.packed = {1280, 720};
+  EXPECT_THROW(open_window_display(options), std::invalid_argument);
 }
 
 TEST(WindowDisplayErrors, KmsIsNotAWindowOutput) {

@@ -1,4 +1,4 @@
-#include "hmz_output/glfw_monitor_model.hpp"
+#include "hmz_output/glfw_x11.hpp"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -7,6 +7,7 @@
 #include <X11/Xatom.h>
 #include <X11/extensions/Xrandr.h>
 
+#include <atomic>
 #include <vector>
 
 #include "hmz_output/monitor_selection.hpp"
@@ -32,5 +33,27 @@ std::string glfw_monitor_model(GLFWmonitor* monitor) {
   if (data) XFree(data);
   return edid_monitor_name(bytes);
 }
+
+namespace {
+
+std::atomic<bool> connection_lost{false};
+
+void on_connection_lost(::Display* /*display*/, void* /*user_data*/) { connection_lost = true; }
+
+// The process-wide handler runs first; Xlib's default one prints its own message and exits.
+int on_io_error(::Display* /*display*/) {
+  connection_lost = true;
+  return 0;
+}
+
+}  // namespace
+
+void survive_x_connection_loss() {
+  connection_lost = false;
+  XSetIOErrorHandler(on_io_error);
+  if (::Display* x_display = glfwGetX11Display()) XSetIOErrorExitHandler(x_display, on_connection_lost, nullptr);
+}
+
+bool x_connection_lost() { return connection_lost; }
 
 }  // namespace nelf
