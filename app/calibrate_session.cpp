@@ -14,6 +14,7 @@
 #include "compositor/calibration_controls.hpp"
 #include "compositor/gl_compositor.hpp"
 #include "compositor/text_overlay.hpp"
+#include "hmz_output/kms_display.hpp"
 #include "hmz_output/packing.hpp"
 #include "hmz_output/window_display.hpp"
 
@@ -62,11 +63,14 @@ std::unique_ptr<Display> open_display(const CalibrateSession& s) {
   options.packed = {s.signal.packed_width(panel[0]), s.signal.packed_height(panel[1])};
   options.title = "nelf calibrate (h: help)";
   options.monitor = s.monitor;
-  if (s.output == OutputKind::kms)
-    throw UserError(
-        "--output kms: KMS output is not available to nelf calibrate in this build; use --output window or "
-        "fullscreen",
-        2);
+  options.connector = s.connector;
+  if (s.output == OutputKind::kms) {
+    try {
+      return open_kms_display(options);
+    } catch (const KmsError& e) {
+      throw UserError(e.what(), 1);
+    }
+  }
   try {
     return open_window_display(options);
   } catch (const std::exception& e) {
@@ -113,6 +117,28 @@ class Session {
     for (const auto& line : CalibrationControls::help_lines()) fmt::print("  {}\n", line);
     std::fflush(stdout);
     show("h: keys   q: quit");
+    // Whatever ends the session, the adjustments are not lost: a display that goes away (X server
+    // gone, HDMI unplugged) still gets the profile saved before the error is reported.
+    std::string lost;
+    try {
+      loop();
+    } catch (const UserError&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      lost = e.what();
+    }
+    if (!settings_.save.empty()) save();
+    if (!lost.empty()) throw UserError(fmt::format("the display went away: {}", lost), 1);
+    const auto& p = controls_.profile();
+    for (Eye eye : {Eye::left, Eye::right}) {
+      const auto& c = p.eye_calibration(eye);
+      fmt::print("{}: shift {}, {} px, rotation {} deg, pitch scale {}\n", eye == Eye::left ? "left" : "right",
+                 c.shift_px.x, c.shift_px.y, c.rotation_deg, c.pitch_scale);
+    }
+  }
+
+ private:
+  void loop() {
     auto last_present = std::chrono::steady_clock::now();
     bool dirty = true;
     while (!interrupted.load() && !display_->close_requested()) {
@@ -151,22 +177,21 @@ class Session {
         std::this_thread::sleep_for(kPoll);
       }
     }
-    if (!settings_.save.empty()) save();
-    const auto& p = controls_.profile();
-    for (Eye eye : {Eye::left, Eye::right}) {
-      const auto& c = p.eye_calibration(eye);
-      fmt::print("{}: shift {}, {} px, rotation {} deg, pitch scale {}\n", eye == Eye::left ? "left" : "right",
-                 c.shift_px.x, c.shift_px.y, c.rotation_deg, c.pitch_scale);
-    }
   }
 
- private:
   // Applies one key; says on screen what it did, saves on w.
   CalibrationStep handle(const KeyPress& key) {
     const CalibrationStep step = controls_.apply(key);
     if (step.quit) return step;
     std::string message = step.message;
-    if (step.save) message = settings_.save.empty() ? "nothing saved: start with --save FILE.toml" : save();
+    if (step.save) {
+      try {
+        message = settings_.save.empty() ? "nothing saved: start with --save FILE.toml" : save();
+      } catch (const UserError& e) {
+        message = fmt::format("not saved: {}", e.what());  // e.g. the disk is full; keep going
+        fmt::print(stderr, "nelf: {}\n", message);
+      }
+    }
     if (step.help) {
       const auto& lines = CalibrationControls::help_lines();
       message = lines[help_line_++ % lines.size()];

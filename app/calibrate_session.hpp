@@ -17,8 +17,9 @@ struct CalibrateSession {
   Signal signal;
   TestPattern pattern = TestPattern::stripes;
   CompositorOptions compositor;
-  std::string monitor;  // fullscreen: a name to match ("" = the one containing "HMZ")
-  std::string save;     // .toml path written on w and at the end ("" = nowhere)
+  std::string monitor;    // fullscreen: a name to match ("" = the one containing "HMZ")
+  std::string connector;  // kms: connector name ("" = the first with a 3D frame-packing mode)
+  std::string save;       // .toml path written on w and at the end ("" = nowhere)
 };
 
 // Runs until q/Esc, the window is closed or SIGINT/SIGTERM; saves to session.save (when given) on

@@ -26,6 +26,7 @@ struct CalibrateArgs {
   std::string output = "window";
   std::string save;
   std::string monitor;
+  std::string connector;
   std::string pattern;
   std::string signal;
   int fsaa = 1;
@@ -118,6 +119,7 @@ void run_calibrate(const CalibrateArgs& args) {
   check_save_path(args.save);
   session.save = args.save;
   session.monitor = args.monitor;
+  session.connector = args.connector;
   run_calibrate_session(session);
 }
 
@@ -147,6 +149,8 @@ void add_calibrate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--monitor", args->monitor,
                   "fullscreen: the monitor whose name contains this (default: one containing \"HMZ\")");
+  cmd->add_option("--connector", args->connector,
+                  "kms: the connector, e.g. HDMI-A-1 (default: the first with a 3D frame-packing mode)");
   cmd->add_option("--save", args->save, "Write the adjusted profile to this .toml file (w, and when quitting)");
   cmd->add_option("--pattern", args->pattern,
                   fmt::format("Pattern: {} (the first one shown; required with an image --output)",
