@@ -129,7 +129,7 @@ Image snellen(const PatternGeometry& g) {
     const double first_centre = label_column + (g.width - label_column - (2.0 * n - 1.0) * h) / 2.0 + h / 2.0;
     for (std::size_t i = 0; i < row.letters.size(); ++i)
       text.draw(first_centre + 2.0 * h * static_cast<double>(i), row.top_px, std::string(1, row.letters[i]), h, true);
-    const double label_h = std::clamp(0.5 * h, 12.0, 40.0);
+    const double label_h = snellen_label_height_px(h);
     text.draw(0.02 * g.width, row.top_px + static_cast<int>(std::lround((h - label_h) / 2.0)),
               fmt::format("20/{}", row.denominator), label_h, false);
   }
@@ -198,24 +198,36 @@ double snellen_letter_height_px(const PatternGeometry& g, int denominator) {
   return height_mm / g.screen_width_mm * g.width;
 }
 
+double snellen_label_height_px(double letter_height_px) { return std::clamp(0.5 * letter_height_px, 12.0, 40.0); }
+
 std::vector<SnellenRow> snellen_layout(const PatternGeometry& g) {
   std::vector<SnellenRow> rows;
-  double top = 0.04 * g.height;
+  const double margin = 0.04 * g.height;
+  double top = margin;
   std::size_t next_letter = 0;
   for (int denominator : kSnellenDenominators) {
     const double h = snellen_letter_height_px(g, denominator);
     if (h > g.height / 6.0) continue;
     if (h < 3.0) break;
-    if (top + h > 0.96 * g.height) break;
+    // A row is as tall as its letters or its label, whichever is taller.
+    const double row_height = std::max(h, snellen_label_height_px(h));
+    if (top + row_height > g.height - margin) break;
     SnellenRow row;
     row.denominator = denominator;
     row.letter_height_px = h;
-    row.top_px = static_cast<int>(std::lround(top));
+    row.top_px = static_cast<int>(std::lround(top + (row_height - h) / 2.0));
     const double usable = 0.8 * g.width;
     const int count = std::clamp(static_cast<int>((usable / h + 1.0) / 2.0), 1, 5);
     for (int i = 0; i < count; ++i) row.letters += kSloanLetters[next_letter++ % kSloanLetters.size()];
     rows.push_back(row);
-    top += h + std::max(0.6 * h, 12.0);
+    top += row_height + std::max(0.6 * h, 10.0);
+  }
+  // The chart centred vertically in the view.
+  if (!rows.empty()) {
+    const double used = rows.back().top_px + rows.back().letter_height_px - rows.front().top_px;
+    const int offset = static_cast<int>(std::lround((g.height - used) / 2.0)) - rows.front().top_px;
+    if (offset > 0)
+      for (auto& row : rows) row.top_px += offset;
   }
   return rows;
 }

@@ -67,7 +67,10 @@ struct SnellenRow {
 };
 
 // The rows that fit the view, largest first: from 20/800 down to 20/10, leaving out rows whose
-// letters would be smaller than 3 view pixels or taller than a sixth of the view.
+// letters would be smaller than 3 view pixels or taller than a sixth of the view; the chart is
+// centred vertically. Each row is labelled "20/x" at the left, its label's cap height
+// snellen_label_height_px.
+double snellen_label_height_px(double letter_height_px);
 std::vector<SnellenRow> snellen_layout(const PatternGeometry& geometry);
 
 // Both eyes' views (display aspect width/height). Throws TestPatternError as above.
