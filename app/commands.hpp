@@ -6,6 +6,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "compositor/compositor.hpp"
+#include "compositor/profile.hpp"
+#include "hmz_output/image_sink.hpp"
+#include "hmz_output/signal.hpp"
 #include "inputs/stereo_layout.hpp"
 
 namespace nelf::app {
@@ -25,6 +29,16 @@ class UserError : public std::runtime_error {
 // Throws UserError (status 2) naming the accepted values.
 std::optional<StereoLayout> parse_layout_option(const std::string& name);
 
+// The signal named `name` (--signal), or the profile's output.signal when `name` is empty.
+// Throws UserError (status 2) naming the signals there are.
+Signal resolve_signal(const Profile& profile, const std::string& name);
+
+// The stills path of convert (also calibrate --pattern): composes `views` with the GL compositor,
+// packs both eyes into `signal`'s frame and writes it to `output` (nothing half-written). Throws
+// UserError (status 1) when the file cannot be written.
+void write_packed_still(const StereoPair& views, const Profile& profile, const Signal& signal,
+                        const CompositorOptions& options, const std::string& output, const ImageWriteOptions& write);
+
 // Adds a subcommand to `app`. The callback it installs is run after parsing; it may throw.
 using CommandRegistrar = void (*)(CLI::App& app);
 
@@ -33,5 +47,6 @@ void add_design_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
 void add_probe_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
+void add_calibrate_command(CLI::App& app);
 
 }  // namespace nelf::app
