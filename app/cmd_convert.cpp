@@ -126,17 +126,34 @@ void run_convert(const ConvertArgs& args) {
   }
   if (!still.decision.warning.empty()) fmt::print(stderr, "nelf: warning: {}\n", still.decision.warning);
 
-  const auto compositor = make_compositor(plan.profile, plan.compositor);
-  const EyeImages eyes = compositor->compose(still.views);
-  const Image frame = pack_eyes(plan.signal, eyes);
+  write_packed_still(still.views, plan.profile, plan.signal, plan.compositor, args.output, plan.write);
+}
+
+}  // namespace
+
+Signal resolve_signal(const Profile& profile, const std::string& name) {
+  const std::string signal_name = name.empty() ? profile.signal : name;
+  const auto signal = find_signal(signal_name);
+  if (!signal) {
+    const std::string source =
+        name.empty() ? fmt::format(" (output.signal of profile {})", profile.name) : std::string();
+    throw UserError(fmt::format("unknown signal '{}'{} (use {})", signal_name, source, fmt::join(signal_names(), ", ")),
+                    2);
+  }
+  return *signal;
+}
+
+void write_packed_still(const StereoPair& views, const Profile& profile, const Signal& signal,
+                        const CompositorOptions& options, const std::string& output, const ImageWriteOptions& write) {
+  const auto compositor = make_compositor(profile, options);
+  const EyeImages eyes = compositor->compose(views);
+  const Image frame = pack_eyes(signal, eyes);
   try {
-    write_image_file(frame, args.output, plan.write);
+    write_image_file(frame, output, write);
   } catch (const ImageWriteError& e) {
     throw UserError(e.what(), 1);
   }
 }
-
-}  // namespace
 
 std::optional<StereoLayout> parse_layout_option(const std::string& name) {
   if (name == "auto") return std::nullopt;
@@ -167,15 +184,7 @@ CommonOptions parse_common_options(const CommonArgs& args, bool still) {
   common.compositor.gpu = args.gpu;
 
   common.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
-  const std::string signal_name = args.signal.empty() ? common.profile.signal : args.signal;
-  const auto signal = find_signal(signal_name);
-  if (!signal) {
-    const std::string source =
-        args.signal.empty() ? fmt::format(" (output.signal of profile {})", common.profile.name) : std::string();
-    throw UserError(fmt::format("unknown signal '{}'{} (use {})", signal_name, source, fmt::join(signal_names(), ", ")),
-                    2);
-  }
-  common.signal = *signal;
+  common.signal = resolve_signal(common.profile, args.signal);
   return common;
 }
 

@@ -8,6 +8,7 @@
 
 #include "compositor/compositor.hpp"
 #include "compositor/profile.hpp"
+#include "hmz_output/image_sink.hpp"
 #include "hmz_output/signal.hpp"
 #include "inputs/stereo_layout.hpp"
 #include "inputs/user_error.hpp"
@@ -47,6 +48,15 @@ void add_common_options(CLI::App& cmd, CommonArgs& args);
 // Throws UserError (status 2) for contradictory options and unknown signals, ProfileError for bad
 // profiles. `still`: the input is a still image (refuses layout alt).
 CommonOptions parse_common_options(const CommonArgs& args, bool still);
+// The signal named `name` (--signal), or the profile's output.signal when `name` is empty.
+// Throws UserError (status 2) naming the signals there are.
+Signal resolve_signal(const Profile& profile, const std::string& name);
+
+// The stills path of convert (also calibrate --pattern): composes `views` with the GL compositor,
+// packs both eyes into `signal`'s frame and writes it to `output` (nothing half-written). Throws
+// UserError (status 1) when the file cannot be written.
+void write_packed_still(const StereoPair& views, const Profile& profile, const Signal& signal,
+                        const CompositorOptions& options, const std::string& output, const ImageWriteOptions& write);
 
 // Adds a subcommand to `app`. The callback it installs is run after parsing; it may throw.
 using CommandRegistrar = void (*)(CLI::App& app);
@@ -57,5 +67,6 @@ void add_convert_command(CLI::App& app);
 void add_probe_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_play_command(CLI::App& app);
+void add_calibrate_command(CLI::App& app);
 
 }  // namespace nelf::app

@@ -1,0 +1,262 @@
+#include "app/calibrate_session.hpp"
+
+#include <fmt/format.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <memory>
+#include <optional>
+#include <thread>
+#include <utility>
+
+#include "app/commands.hpp"
+#include "compositor/calibration_controls.hpp"
+#include "compositor/gl_compositor.hpp"
+#include "compositor/text_overlay.hpp"
+#include "hmz_output/kms_display.hpp"
+#include "hmz_output/packing.hpp"
+#include "hmz_output/window_display.hpp"
+
+namespace nelf::app {
+
+namespace {
+
+// How long a change stays on screen.
+constexpr auto kMessageTime = std::chrono::milliseconds(2500);
+// With nothing changing, the frame is presented again this often (a window that was covered
+// shows it again) and the keys polled in between.
+constexpr auto kIdlePresent = std::chrono::milliseconds(100);
+constexpr auto kPoll = std::chrono::milliseconds(10);
+
+std::atomic<bool> interrupted{false};
+extern "C" void on_calibrate_interrupt(int) { interrupted.store(true); }
+
+// SIGINT/SIGTERM end the session cleanly (the profile is still saved) for its lifetime.
+class InterruptGuard {
+ public:
+  InterruptGuard() {
+    interrupted.store(false);
+    struct sigaction action {};
+    action.sa_handler = on_calibrate_interrupt;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &previous_int_);
+    sigaction(SIGTERM, &action, &previous_term_);
+  }
+  ~InterruptGuard() {
+    sigaction(SIGINT, &previous_int_, nullptr);
+    sigaction(SIGTERM, &previous_term_, nullptr);
+  }
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+ private:
+  struct sigaction previous_int_ {};
+  struct sigaction previous_term_ {};
+};
+
+std::unique_ptr<Display> open_display(const CalibrateSession& s) {
+  DisplayOptions options;
+  options.kind = s.output;
+  options.signal = s.signal;
+  const auto panel = s.profile.display.resolution;
+  options.packed = {s.signal.packed_width(panel[0]), s.signal.packed_height(panel[1])};
+  options.title = "nelf calibrate (h: help)";
+  options.monitor = s.monitor;
+  options.connector = s.connector;
+  if (s.output == OutputKind::kms) {
+    try {
+      return open_kms_display(options);
+    } catch (const KmsError& e) {
+      throw UserError(e.what(), 1);
+    }
+  }
+  try {
+    return open_window_display(options);
+  } catch (const std::exception& e) {
+    throw UserError(e.what(), 1);
+  }
+}
+
+// The pattern's views on the GPU, rebuilt when the pattern or its geometry changes.
+struct PatternTextures {
+  gl::Texture left, right;
+  int width = 0, height = 0;
+  double aspect = 0.0;
+
+  void upload(TestPattern pattern, const PatternGeometry& geometry) {
+    StereoPair views;
+    try {
+      views = make_test_pattern(pattern, geometry);
+    } catch (const TestPatternError& e) {
+      throw UserError(fmt::format("pattern {}: {}", test_pattern_name(pattern), e.what()), 2);
+    }
+    left = upload_texture(views.left.image, GL_RGBA8);
+    right = upload_texture(views.right.image, GL_RGBA8);
+    width = views.left.image.width();
+    height = views.left.image.height();
+    aspect = views.left.aspect();
+  }
+  GlTextureView view(Eye eye) const { return {(eye == Eye::left ? left : right).id(), width, height, aspect}; }
+};
+
+class Session {
+ public:
+  explicit Session(const CalibrateSession& s)
+      : settings_(s),
+        display_(open_display(s)),
+        controls_(s.profile, s.pattern, 16.0 / 9.0),
+        compositor_(std::make_unique<GlCompositor>(s.profile, s.compositor, display_->context())) {
+    upload_pattern();
+  }
+
+  void run() {
+    InterruptGuard guard;
+    fmt::print("nelf calibrate: {}; h shows the keys, q quits{}\n", display_->description(),
+               settings_.save.empty() ? " (no --save: nothing is written)" : ", saving to " + settings_.save);
+    for (const auto& line : CalibrationControls::help_lines()) fmt::print("  {}\n", line);
+    std::fflush(stdout);
+    show("h: keys   q: quit");
+    // Whatever ends the session, the adjustments are not lost: a display that goes away (X server
+    // gone, HDMI unplugged) still gets the profile saved before the error is reported.
+    std::string lost;
+    try {
+      loop();
+    } catch (const UserError&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      lost = e.what();
+    }
+    if (!settings_.save.empty()) save();
+    if (!lost.empty()) throw UserError(fmt::format("the display went away: {}", lost), 1);
+    const auto& p = controls_.profile();
+    for (Eye eye : {Eye::left, Eye::right}) {
+      const auto& c = p.eye_calibration(eye);
+      fmt::print("{}: shift {}, {} px, rotation {} deg, pitch scale {}\n", eye == Eye::left ? "left" : "right",
+                 c.shift_px.x, c.shift_px.y, c.rotation_deg, c.pitch_scale);
+    }
+  }
+
+ private:
+  void loop() {
+    auto last_present = std::chrono::steady_clock::now();
+    bool dirty = true;
+    while (!interrupted.load() && !display_->close_requested()) {
+      bool quit = false;
+      // Keys arrive in batches (key repeat, fast typing): the compositor and the pattern are
+      // rebuilt once per batch, for the last state.
+      bool profile_changed = false, pattern_changed = false;
+      for (const KeyPress& key : display_->poll_events()) {
+        const CalibrationStep step = handle(key);
+        if ((quit = step.quit)) break;
+        profile_changed |= step.profile_changed;
+        pattern_changed |= step.pattern_changed;
+        dirty |= step.profile_changed || step.pattern_changed || !step.message.empty() || step.save || step.help;
+      }
+      if (quit) break;
+      if (profile_changed) {
+        // The mapping follows the profile: a new compositor (its programs come from Mesa's shader
+        // cache or the driver's), and the pattern drawn again where its geometry changed.
+        compositor_ = std::make_unique<GlCompositor>(controls_.profile(), settings_.compositor, display_->context());
+      }
+      if (profile_changed || pattern_changed) upload_pattern();
+      const auto now = std::chrono::steady_clock::now();
+      if (!overlay_.text().empty() && now >= message_until_) {
+        overlay_.set_text("");
+        dirty = true;
+      }
+      const bool rendered = dirty;
+      if (dirty) {
+        render();
+        dirty = false;
+      }
+      if (rendered || now - last_present >= kIdlePresent) {
+        display_->present();
+        last_present = std::chrono::steady_clock::now();
+      } else {
+        std::this_thread::sleep_for(kPoll);
+      }
+    }
+  }
+
+  // Applies one key; says on screen what it did, saves on w.
+  CalibrationStep handle(const KeyPress& key) {
+    const CalibrationStep step = controls_.apply(key);
+    if (step.quit) return step;
+    std::string message = step.message;
+    if (step.save) {
+      try {
+        message = settings_.save.empty() ? "nothing saved: start with --save FILE.toml" : save();
+      } catch (const UserError& e) {
+        message = fmt::format("not saved: {}", e.what());  // e.g. the disk is full; keep going
+        fmt::print(stderr, "nelf: {}\n", message);
+      }
+    }
+    if (step.help) {
+      const auto& lines = CalibrationControls::help_lines();
+      message = lines[help_line_++ % lines.size()];
+    }
+    if (!message.empty()) show(message);
+    return step;
+  }
+
+  // Draws the pattern again when it or its geometry (screen size and distance, display pixel
+  // footprint) changed; a shift or rotation alone leaves it as it is.
+  void upload_pattern() {
+    const PatternGeometry geometry = pattern_geometry(controls_.profile());
+    if (uploaded_ && geometry == uploaded_->first && controls_.pattern() == uploaded_->second) return;
+    patterns_.upload(controls_.pattern(), geometry);
+    uploaded_ = {geometry, controls_.pattern()};
+  }
+
+  void show(const std::string& message) {
+    overlay_.set_text(message);
+    message_until_ = std::chrono::steady_clock::now() + kMessageTime;
+  }
+
+  std::string save() {
+    save_calibrated_profile(controls_.profile(), settings_.save);
+    const std::string line = fmt::format("saved {}", settings_.save);
+    fmt::print("nelf calibrate: {}\n", line);
+    std::fflush(stdout);
+    return line;
+  }
+
+  void render() {
+    display_->context()->make_current();
+    const GLuint fbo = display_->packed_framebuffer();
+    const GLfloat black[4] = {0.f, 0.f, 0.f, 1.f};
+    glClearNamedFramebufferfv(fbo, GL_COLOR, 0, black);
+    const auto panel = controls_.profile().display.resolution;
+    for (Eye eye : {Eye::left, Eye::right}) {
+      const auto area = eye_area(settings_.signal, eye, panel[0], panel[1]);
+      if (!area) continue;
+      // Centred 1:1 in the eye area, as pack_eyes does for files.
+      const GlTarget target{fbo, area->x + (area->width - panel[0]) / 2, area->y + (area->height - panel[1]) / 2};
+      compositor_->render_eye(eye, overlay_.apply(eye, patterns_.view(eye)), target);
+    }
+  }
+
+  const CalibrateSession& settings_;
+  std::unique_ptr<Display> display_;
+  CalibrationControls controls_;
+  std::unique_ptr<GlCompositor> compositor_;
+  TextOverlay overlay_;
+  PatternTextures patterns_;
+  std::optional<std::pair<PatternGeometry, TestPattern>> uploaded_;
+  std::chrono::steady_clock::time_point message_until_;
+  std::size_t help_line_ = 0;
+};
+
+}  // namespace
+
+void run_calibrate_session(const CalibrateSession& session) {
+  try {
+    CalibrationControls check(session.profile, session.pattern, 16.0 / 9.0);
+  } catch (const ProfileError& e) {
+    throw UserError(e.what(), 2);
+  }
+  Session(session).run();
+}
+
+}  // namespace nelf::app

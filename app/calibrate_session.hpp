@@ -1,0 +1,32 @@
+#pragma once
+// The interactive part of `nelf calibrate`: a live display showing the current test pattern through
+// the compositor, keys handled by CalibrationControls, each change shown briefly on screen.
+#include <string>
+
+#include "compositor/compositor.hpp"
+#include "compositor/profile.hpp"
+#include "hmz_output/display.hpp"
+#include "hmz_output/signal.hpp"
+#include "inputs/test_patterns.hpp"
+
+namespace nelf::app {
+
+struct CalibrateSession {
+  OutputKind output = OutputKind::window;
+  Profile profile;
+  Signal signal;
+  TestPattern pattern = TestPattern::stripes;
+  CompositorOptions compositor;
+  std::string monitor;    // fullscreen: a name to match ("" = the one containing "HMZ")
+  std::string connector;  // kms: connector name ("" = the first with a 3D frame-packing mode)
+  std::string save;       // .toml path written on w and at the end ("" = nowhere)
+};
+
+// Runs until q/Esc, the window is closed or SIGINT/SIGTERM; saves to session.save (when given) on
+// w and at the end, saying where on stdout. Throws UserError for a display that cannot open.
+void run_calibrate_session(const CalibrateSession& session);
+
+// Writes `profile` as TOML to `path` (replacing it, never half-written); UserError when it cannot.
+void save_calibrated_profile(const Profile& profile, const std::string& path);
+
+}  // namespace nelf::app

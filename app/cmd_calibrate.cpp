@@ -1,0 +1,167 @@
+// `nelf calibrate`: test patterns drawn through the compositor, with keys that tune the profile's
+// calibration live (compositor/calibration_controls) and --save to keep the result; or, with
+// --pattern and an image file as --output, the packed pattern frame written headless like a still
+// converted by `nelf convert`.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "app/calibrate_session.hpp"
+#include "app/commands.hpp"
+#include "compositor/profile.hpp"
+#include "hmz_output/display.hpp"
+#include "hmz_output/image_sink.hpp"
+#include "inputs/test_patterns.hpp"
+
+namespace nelf::app {
+namespace {
+
+struct CalibrateArgs {
+  std::string profile = "hmz-t1";
+  std::string output = "window";
+  std::string save;
+  std::string monitor;
+  std::string connector;
+  std::string pattern;
+  std::string signal;
+  int fsaa = 1;
+  std::optional<int> gpu;
+  bool overwrite = false;
+};
+
+bool is_output_kind(const std::string& name) {
+  try {
+    parse_output_kind(name);
+    return true;
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+}
+
+TestPattern parse_pattern_option(const std::string& name) {
+  const auto pattern = parse_test_pattern(name);
+  if (!pattern)
+    throw UserError(fmt::format("unknown pattern '{}' (use {})", name, fmt::join(test_pattern_names(), ", ")), 2);
+  return *pattern;
+}
+
+CompositorOptions compositor_options(const CalibrateArgs& args) {
+  try {
+    validate_fsaa(args.fsaa);
+  } catch (const std::invalid_argument& e) {
+    throw UserError(e.what(), 2);
+  }
+  CompositorOptions options;
+  options.fsaa = args.fsaa;
+  options.gpu = args.gpu;
+  return options;
+}
+
+StereoPair pattern_views(TestPattern pattern, const Profile& profile) {
+  try {
+    return make_test_pattern(pattern, pattern_geometry(profile));
+  } catch (const TestPatternError& e) {
+    throw UserError(fmt::format("pattern {}: {}", test_pattern_name(pattern), e.what()), 2);
+  }
+}
+
+// Headless: the packed frame of one pattern as an image file.
+void write_pattern_image(const CalibrateArgs& args) {
+  if (args.pattern.empty())
+    throw UserError(fmt::format("--output {} is an image file: give the pattern to write with --pattern {}",
+                                args.output, fmt::join(test_pattern_names(), "|")),
+                    2);
+  if (!args.save.empty())
+    throw UserError(
+        "--save keeps what the keys adjusted and needs a window (--output window, fullscreen, kms or "
+        "quad-buffer), not an image file",
+        2);
+  const TestPattern pattern = parse_pattern_option(args.pattern);
+  const CompositorOptions options = compositor_options(args);
+  const Profile profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
+  const Signal signal = resolve_signal(profile, args.signal);
+  ImageWriteOptions write;
+  write.overwrite = args.overwrite;
+  try {
+    check_image_writable(args.output, write);
+  } catch (const ImageWriteError& e) {
+    throw UserError(e.what(), 1);
+  }
+  write_packed_still(pattern_views(pattern, profile), profile, signal, options, args.output, write);
+}
+
+// --save must be writable before the user spends time calibrating.
+void check_save_path(const std::string& path) {
+  if (path.empty()) return;
+  const std::filesystem::path p(path);
+  const auto dir = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec))
+    throw UserError(fmt::format("--save {}: directory {} does not exist", path, dir.string()), 1);
+  if (std::filesystem::is_directory(p, ec)) throw UserError(fmt::format("--save {}: is a directory", path), 1);
+  if (p.extension() != ".toml")
+    throw UserError(fmt::format("--save {}: a profile is a .toml file (e.g. my-hmz.toml)", path), 2);
+}
+
+void run_calibrate(const CalibrateArgs& args) {
+  if (!is_output_kind(args.output)) return write_pattern_image(args);
+  CalibrateSession session;
+  session.output = parse_output_kind(args.output);
+  session.pattern = args.pattern.empty() ? TestPattern::stripes : parse_pattern_option(args.pattern);
+  session.compositor = compositor_options(args);
+  session.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
+  session.signal = resolve_signal(session.profile, args.signal);
+  check_save_path(args.save);
+  session.save = args.save;
+  session.monitor = args.monitor;
+  session.connector = args.connector;
+  run_calibrate_session(session);
+}
+
+}  // namespace
+
+void save_calibrated_profile(const Profile& profile, const std::string& path) {
+  try {
+    write_file_atomically(path, true, [&](const std::filesystem::path& temporary) {
+      std::ofstream out(temporary, std::ios::binary);
+      out << profile_to_toml(profile);
+      out.close();
+      if (!out) throw ImageWriteError(fmt::format("{}: cannot write the profile (disk full?)", path));
+    });
+  } catch (const ImageWriteError& e) {
+    throw UserError(e.what(), 1);
+  }
+}
+
+void add_calibrate_command(CLI::App& app) {
+  auto args = std::make_shared<CalibrateArgs>();
+  auto* cmd = app.add_subcommand(
+      "calibrate", "Tune a profile to your eyes with test patterns and keys (h for help), or write a pattern image");
+  cmd->add_option("--profile", args->profile, "Device profile to start from: built-in name or TOML file")
+      ->capture_default_str();
+  cmd->add_option("--output", args->output,
+                  "window, fullscreen, kms or quad-buffer; or an image file (.png, .tif, .exr, .jpg) for --pattern")
+      ->capture_default_str();
+  cmd->add_option("--monitor", args->monitor,
+                  "fullscreen: the monitor whose name contains this (default: one containing \"HMZ\")");
+  cmd->add_option("--connector", args->connector,
+                  "kms: the connector, e.g. HDMI-A-1 (default: the first with a 3D frame-packing mode)");
+  cmd->add_option("--save", args->save, "Write the adjusted profile to this .toml file (w, and when quitting)");
+  cmd->add_option("--pattern", args->pattern,
+                  fmt::format("Pattern: {} (the first one shown; required with an image --output)",
+                              fmt::join(test_pattern_names(), ", ")));
+  cmd->add_option(
+      "--signal", args->signal,
+      fmt::format("Output signal: {} (default: the profile's output.signal)", fmt::join(signal_names(), ", ")));
+  cmd->add_option("--fsaa", args->fsaa, "Antialiasing: 0, 1, 4 or 16 (as for convert)")->capture_default_str();
+  cmd->add_option("--gpu", args->gpu, "EGL device index (image output)");
+  cmd->add_flag("-y,--overwrite", args->overwrite, "Replace the image --output if it exists");
+  cmd->callback([args] { run_calibrate(*args); });
+}
+
+}  // namespace nelf::app

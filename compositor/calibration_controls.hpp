@@ -1,0 +1,77 @@
+#pragma once
+// The keys of `nelf calibrate`, without any window: a profile being adjusted, the eye the keys act
+// on and the pattern shown. apply() takes one key press and says what changed, with one line for
+// the on-screen message. Every value stays within the profile's validation rules and the geometry
+// must still work (the screen fits the field of view), so a saved profile always loads.
+//
+//   Tab          adjust both eyes / the left eye / the right eye
+//   arrows       shift the image 1 px (Shift: 0.1 px)         calibration.<eye>.shift_px
+//   r / R        rotation -/+ 0.05 deg                         calibration.<eye>.rotation_deg
+//   p / P        pitch scale -/+ 0.0005                        calibration.<eye>.pitch_scale
+//   g / G        lens gap -/+ 0.005 mm (both eyes)             lens_array.gap_mm
+//   [ / ]        IPD -/+ 0.5 mm                                viewing.ipd_mm
+//   d / D        prescription -/+ 0.25 D                       correction.prescription_diopters
+//   1 2 3 4      stripes, grid, Snellen chart, white
+//   w            save now;  h  help (each press the next line);  q / Esc / Ctrl+C  quit
+#include <string>
+#include <vector>
+
+#include "compositor/profile.hpp"
+#include "hmz_output/display.hpp"
+#include "inputs/test_patterns.hpp"
+
+namespace nelf {
+
+enum class CalibrationEye { both, left, right };
+std::string calibration_eye_name(CalibrationEye eye);  // "both eyes", "left eye", "right eye"
+
+struct CalibrationStep {
+  bool profile_changed = false;  // re-render with profile()
+  bool pattern_changed = false;  // re-render with pattern()
+  bool save = false;             // write the profile now (w)
+  bool quit = false;             // q / Esc
+  bool help = false;             // show help_lines()
+  std::string message;           // one line for the screen (ASCII), empty for nothing to say
+};
+
+class CalibrationControls {
+ public:
+  // `content_aspect`: the display aspect of the patterns, for checking that the screen still fits.
+  // Throws ProfileError when `profile`'s geometry does not work to begin with.
+  CalibrationControls(Profile profile, TestPattern pattern, double content_aspect = 16.0 / 9.0);
+
+  CalibrationStep apply(const KeyPress& key);
+
+  const Profile& profile() const { return profile_; }
+  CalibrationEye selected_eye() const { return eye_; }
+  TestPattern pattern() const { return pattern_; }
+
+  static const std::vector<std::string>& help_lines();
+
+  // Step sizes (also the README's).
+  static constexpr double shift_step_px = 1.0, fine_shift_step_px = 0.1;
+  static constexpr double rotation_step_deg = 0.05;
+  static constexpr double pitch_scale_step = 0.0005;
+  static constexpr double gap_step_mm = 0.005;
+  static constexpr double ipd_step_mm = 0.5;
+  static constexpr double prescription_step_diopters = 0.25;
+
+ private:
+  CalibrationStep shift(double dx, double dy);
+  CalibrationStep rotate(double delta);
+  CalibrationStep scale_pitch(double delta);
+  CalibrationStep change_gap(double delta);
+  CalibrationStep change_ipd(double delta);
+  CalibrationStep change_prescription(double delta);
+  // Takes `candidate` when it loads and its geometry works; otherwise keeps the current profile
+  // and says why.
+  CalibrationStep accept(const Profile& candidate, std::string message);
+  std::vector<Eye> selected() const;
+
+  Profile profile_;
+  TestPattern pattern_;
+  double content_aspect_;
+  CalibrationEye eye_ = CalibrationEye::both;
+};
+
+}  // namespace nelf
