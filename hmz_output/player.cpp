@@ -7,6 +7,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <cstring>
 #include <deque>
 #include <exception>
 #include <memory>
@@ -21,6 +22,7 @@
 #include "hmz_output/audio_output.hpp"
 #include "hmz_output/packing.hpp"
 #include "inputs/audio_source.hpp"
+#include "inputs/test_patterns.hpp"
 #include "inputs/user_error.hpp"
 
 namespace nelf {
@@ -223,21 +225,26 @@ class AudioFeeder {
   std::jthread thread_;  // last: stops before the members it uses go
 };
 
-// White grid lines over a view (calibration overlay): every 1/16 of the width, 2 pixels wide, and
-// a centre cross, so that the two eyes' alignment and the lens grid can be judged.
-void draw_grid(std::vector<std::uint8_t>& pixels, int width, int height, int bits) {
-  const std::size_t bpp = bytes_per_pixel(bits);
-  const int step = std::max(8, width / 16);
-  auto paint = [&](int x, int y) {
-    std::uint8_t* p = &pixels[(static_cast<std::size_t>(y) * width + x) * bpp];
-    std::fill(p, p + bpp, std::uint8_t{0xff});
-  };
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const bool line = (x % step) < 2 || (y % step) < 2;
-      const bool cross = std::abs(x - width / 2) < 2 || std::abs(y - height / 2) < 2;
-      if (line || cross) paint(x, y);
+// The calibration overlay: `nelf calibrate`'s grid pattern (lines 16 cells across, a yellow centre
+// cross, the eye's letter) drawn over the view, so that the eyes' alignment and the lens grid can
+// be judged on the movie itself. `pattern` is the grid as RGBA float at the view's size.
+void draw_over(std::vector<std::uint8_t>& pixels, const Image& pattern, int bits) {
+  const std::size_t n = static_cast<std::size_t>(pattern.width()) * pattern.height();
+  const float* p = pattern.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const float r = p[i * 4], g = p[i * 4 + 1], b = p[i * 4 + 2];
+    if (std::max({r, g, b}) < 0.02f) continue;  // black: the movie shows through
+    const float rgb[3] = {r, g, b};
+    for (int c = 0; c < 3; ++c) {
+      const float v = std::clamp(rgb[c], 0.f, 1.f);
+      if (bits > 8) {
+        const auto u = static_cast<std::uint16_t>(std::lround(v * 65535.f));
+        std::memcpy(&pixels[i * 8 + static_cast<std::size_t>(c) * 2], &u, 2);
+      } else {
+        pixels[i * 4 + static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(std::lround(v * 255.f));
+      }
     }
+  }
 }
 
 // The GL side: view textures, the compositor (rebuilt when the optics change) and the eye areas.
@@ -276,13 +283,23 @@ class PackedRenderer {
       const auto& source = i == 0 ? frame.left : frame.right;
       if (calibration) {
         std::vector<std::uint8_t> copy = source;
-        draw_grid(copy, view_w_, view_h_, bits_);
+        draw_over(copy, calibration_grid(i), bits_);
         glTextureSubImage2D(views_[i].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, copy.data());
       } else {
         glTextureSubImage2D(views_[i].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, source.data());
       }
     }
     gl::check_error("uploading the views");
+  }
+
+  // The grid for view `i` at the current view size and optics (made when first needed).
+  const Image& calibration_grid(int i) {
+    const PatternGeometry geometry = pattern_geometry(profile_, view_w_, view_h_);
+    if (!grid_ || !(grid_geometry_ == geometry)) {
+      grid_ = make_test_pattern(TestPattern::grid, geometry);
+      grid_geometry_ = geometry;
+    }
+    return i == 0 ? grid_->left.image : grid_->right.image;
   }
 
   // The on-screen message ("" for none), blended into both views before compositing so that it
@@ -332,6 +349,8 @@ class PackedRenderer {
   Profile profile_;
   std::unique_ptr<GlCompositor> compositor_;
   TextOverlay overlay_;
+  std::optional<StereoPair> grid_;
+  PatternGeometry grid_geometry_;
   std::array<std::optional<std::pair<int, int>>, 2> origins_;
   std::array<gl::Texture, 2> views_;
   int view_w_ = 0, view_h_ = 0, bits_ = 8;
@@ -526,7 +545,14 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
         say(swap_eyes ? "eyes swapped" : "eyes as the source says");
       } else if (key.is(U'c') || key.is(U'C')) {
         calibration = !calibration;
-        if (current) renderer.upload(*current, calibration);
+        try {
+          if (current) renderer.upload(*current, calibration);
+        } catch (const TestPatternError& e) {
+          calibration = false;
+          if (current) renderer.upload(*current, calibration);
+          say(fmt::format("no calibration grid: {}", e.what()));
+          continue;
+        }
         dirty = true;
         say(calibration ? "calibration grid on" : "calibration grid off");
       } else if (key.is(U'f') || key.is(U'F')) {
