@@ -24,16 +24,8 @@
 namespace nelf::app {
 namespace {
 
-struct ConvertArgs {
-  std::string input;
+struct ConvertArgs : CommonArgs {
   std::string output;
-  std::string profile = "hmz-t1";
-  std::string layout = "auto";
-  std::string right;
-  bool swap_eyes = false;
-  std::string signal;  // empty = the profile's output.signal
-  int fsaa = 1;
-  std::optional<int> gpu;
   int bits = 8;
   bool overwrite = false;
   // Video only.
@@ -41,7 +33,7 @@ struct ConvertArgs {
   std::optional<int> crf;
   std::optional<double> start, duration;
   std::optional<long> frames;
-  bool no_audio = false, quiet = false, strict = false, allow_network = false;
+  bool no_audio = false, quiet = false, strict = false;
 };
 
 // Still images go through OpenImageIO; everything else (and `synthetic:`) is video.
@@ -62,40 +54,6 @@ struct ConvertPlan {
   CompositorOptions compositor;
   ImageWriteOptions write;
 };
-
-// What stills and video share: the layout flags, antialiasing, device and signal, all checked
-// before any input is read. `still` refuses what only video can do (alt).
-struct CommonOptions {
-  std::optional<StereoLayout> layout;
-  CompositorOptions compositor;
-  Profile profile;
-  Signal signal;
-};
-
-CommonOptions parse_common_options(const ConvertArgs& args, bool still) {
-  CommonOptions common;
-  common.layout = parse_layout_option(args.layout);
-  if (common.layout) {
-    if (still && *common.layout == StereoLayout::alt)
-      throw UserError("layout alt (frame-sequential) needs a video; a still holds one view per frame", 2);
-    if (*common.layout == StereoLayout::pair && args.right.empty())
-      throw UserError("layout pair needs the right view as a second file (--right FILE)", 2);
-  }
-  if (!args.right.empty() && common.layout && *common.layout != StereoLayout::pair)
-    throw UserError(fmt::format("--right gives the right view as a second file; layout {} does not apply", args.layout),
-                    2);
-  try {
-    validate_fsaa(args.fsaa);
-  } catch (const std::invalid_argument& e) {
-    throw UserError(e.what(), 2);
-  }
-  common.compositor.fsaa = args.fsaa;
-  common.compositor.gpu = args.gpu;
-
-  common.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
-  common.signal = resolve_signal(common.profile, args.signal);
-  return common;
-}
 
 ConvertPlan plan_convert(const ConvertArgs& args) {
   ConvertPlan plan;
@@ -205,26 +163,57 @@ std::optional<StereoLayout> parse_layout_option(const std::string& name) {
   return layout;
 }
 
+CommonOptions parse_common_options(const CommonArgs& args, bool still) {
+  CommonOptions common;
+  common.layout = parse_layout_option(args.layout);
+  if (common.layout) {
+    if (still && *common.layout == StereoLayout::alt)
+      throw UserError("layout alt (frame-sequential) needs a video; a still holds one view per frame", 2);
+    if (*common.layout == StereoLayout::pair && args.right.empty())
+      throw UserError("layout pair needs the right view as a second file (--right FILE)", 2);
+  }
+  if (!args.right.empty() && common.layout && *common.layout != StereoLayout::pair)
+    throw UserError(fmt::format("--right gives the right view as a second file; layout {} does not apply", args.layout),
+                    2);
+  try {
+    validate_fsaa(args.fsaa);
+  } catch (const std::invalid_argument& e) {
+    throw UserError(e.what(), 2);
+  }
+  common.compositor.fsaa = args.fsaa;
+  common.compositor.gpu = args.gpu;
+
+  common.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
+  common.signal = resolve_signal(common.profile, args.signal);
+  return common;
+}
+
+void add_common_options(CLI::App& cmd, CommonArgs& args) {
+  cmd.add_option("input", args.input, "Stereo image or video (side-by-side, top-bottom, frame-packed, JPS, MPO, ...)")
+      ->required();
+  cmd.add_option("--profile", args.profile, "Device profile: built-in name or TOML file")->capture_default_str();
+  cmd.add_option("--layout", args.layout,
+                 fmt::format("Stereo layout of the input: auto, {}", fmt::join(stereo_layout_names(), ", ")))
+      ->capture_default_str();
+  cmd.add_option("--right", args.right, "The right view as a separate file (layout pair)");
+  cmd.add_flag("--swap-eyes", args.swap_eyes, "The source stores the right view first");
+  cmd.add_option(
+      "--signal", args.signal,
+      fmt::format("Output signal: {} (default: the profile's output.signal)", fmt::join(signal_names(), ", ")));
+  cmd.add_option("--fsaa", args.fsaa, "Antialiasing: 0 (one tap), 1 (prefilter), 4 or 16 (sub-samples)")
+      ->capture_default_str();
+  cmd.add_option("--gpu", args.gpu,
+                 "EGL device index to render on (default: NELF_GPU, else the first GPU, else software)");
+  cmd.add_flag("--allow-network", args.allow_network,
+               "Let FFmpeg use network protocols (default: files and pipes only)");
+}
+
 void add_convert_command(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();
   auto* cmd =
       app.add_subcommand("convert", "Convert a stereo image or video (or synthetic:) into what the display needs");
-  cmd->add_option("input", args->input, "Stereo image (side-by-side, top-bottom, frame-packed, JPS, MPO, ...)")
-      ->required();
+  add_common_options(*cmd, *args);
   cmd->add_option("output", args->output, "Output image (.png, .tif, .exr, .jpg)")->required();
-  cmd->add_option("--profile", args->profile, "Device profile: built-in name or TOML file")->capture_default_str();
-  cmd->add_option("--layout", args->layout,
-                  fmt::format("Stereo layout of the input: auto, {}", fmt::join(stereo_layout_names(), ", ")))
-      ->capture_default_str();
-  cmd->add_option("--right", args->right, "The right view as a separate image (layout pair)");
-  cmd->add_flag("--swap-eyes", args->swap_eyes, "The source stores the right view first");
-  cmd->add_option(
-      "--signal", args->signal,
-      fmt::format("Output signal: {} (default: the profile's output.signal)", fmt::join(signal_names(), ", ")));
-  cmd->add_option("--fsaa", args->fsaa, "Antialiasing: 0 (one tap), 1 (prefilter), 4 or 16 (sub-samples)")
-      ->capture_default_str();
-  cmd->add_option("--gpu", args->gpu,
-                  "EGL device index to render on (default: NELF_GPU, else the first GPU, else software)");
   cmd->add_option("--bits", args->bits, "Bits per channel of the output file: 8, or 16 for .png/.tif")
       ->capture_default_str();
   cmd->add_flag("-y,--overwrite", args->overwrite, "Replace the output file if it exists");
@@ -236,8 +225,6 @@ void add_convert_command(CLI::App& app) {
   cmd->add_flag("--no-audio", args->no_audio, "Video: leave the audio out");
   cmd->add_flag("--quiet", args->quiet, "Video: no progress output");
   cmd->add_flag("--strict", args->strict, "Video: a damaged or truncated input is an error");
-  cmd->add_flag("--allow-network", args->allow_network,
-                "Let FFmpeg use network protocols (default: files and pipes only)");
   cmd->callback([args] { run_convert(*args); });
 }
 

@@ -11,24 +11,43 @@
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/signal.hpp"
 #include "inputs/stereo_layout.hpp"
+#include "inputs/user_error.hpp"
 
 namespace nelf::app {
 
-// A problem with how nelf was invoked or with its input; main() prints what() as one line and
-// exits with `status` (2 for bad arguments or profiles, 1 for failed jobs).
-class UserError : public std::runtime_error {
- public:
-  explicit UserError(const std::string& message, int status = 1) : std::runtime_error(message), status_(status) {}
-  int status() const { return status_; }
-
- private:
-  int status_;
-};
+// See inputs/user_error.hpp: main() prints what() as one line and exits with status().
+using nelf::UserError;
 
 // The --layout option of convert and simulate: "auto" (nullopt: detect) or a layout name.
 // Throws UserError (status 2) naming the accepted values.
 std::optional<StereoLayout> parse_layout_option(const std::string& name);
 
+// The input, layout and rendering options that convert and play share (one parser, one wording).
+struct CommonArgs {
+  std::string input;
+  std::string profile = "hmz-t1";
+  std::string layout = "auto";
+  std::string right;
+  bool swap_eyes = false;
+  std::string signal;  // empty = the profile's output.signal
+  int fsaa = 1;
+  std::optional<int> gpu;
+  bool allow_network = false;
+};
+
+// CommonArgs checked before any input is read: layout, antialiasing, device, profile and signal.
+struct CommonOptions {
+  std::optional<StereoLayout> layout;
+  CompositorOptions compositor;
+  Profile profile;
+  Signal signal;
+};
+
+// Registers INPUT (positional) and the CommonArgs options on `cmd`.
+void add_common_options(CLI::App& cmd, CommonArgs& args);
+// Throws UserError (status 2) for contradictory options and unknown signals, ProfileError for bad
+// profiles. `still`: the input is a still image (refuses layout alt).
+CommonOptions parse_common_options(const CommonArgs& args, bool still);
 // The signal named `name` (--signal), or the profile's output.signal when `name` is empty.
 // Throws UserError (status 2) naming the signals there are.
 Signal resolve_signal(const Profile& profile, const std::string& name);
@@ -47,6 +66,7 @@ void add_design_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
 void add_probe_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
+void add_play_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
 
 }  // namespace nelf::app

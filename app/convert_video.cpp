@@ -18,12 +18,14 @@ extern "C" {
 }
 
 #include "app/commands.hpp"
+#include "app/interrupt.hpp"
 #include "compositor/gl_compositor.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
 #include "hmz_output/progress.hpp"
 #include "inputs/bounded_queue.hpp"
 #include "inputs/ffmpeg_raii.hpp"
+#include "inputs/stereo_frame_source.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
@@ -31,245 +33,6 @@ extern "C" {
 namespace nelf::app {
 
 namespace {
-
-// Set by SIGINT/SIGTERM while a conversion runs; every stage polls it.
-std::atomic<bool> interrupted{false};
-extern "C" void on_interrupt(int) { interrupted.store(true); }
-
-// Installs the handlers for the lifetime of the conversion and restores the previous ones.
-class InterruptGuard {
- public:
-  InterruptGuard() {
-    interrupted.store(false);
-    struct sigaction action {};
-    action.sa_handler = on_interrupt;
-    sigemptyset(&action.sa_mask);
-    sigaction(SIGINT, &action, &previous_int_);
-    sigaction(SIGTERM, &action, &previous_term_);
-  }
-  ~InterruptGuard() {
-    sigaction(SIGINT, &previous_int_, nullptr);
-    sigaction(SIGTERM, &previous_term_, nullptr);
-  }
-  InterruptGuard(const InterruptGuard&) = delete;
-  InterruptGuard& operator=(const InterruptGuard&) = delete;
-
- private:
-  struct sigaction previous_int_ {};
-  struct sigaction previous_term_ {};
-};
-
-// Both views of one stereo frame, as tightly packed RGBA of `bits` per channel.
-struct StereoVideoFrame {
-  int width = 0, height = 0, bits = 8;
-  std::vector<std::uint8_t> left, right;
-  double aspect = 0.0;
-  double pts_s = 0.0;  // output time, from 0
-};
-
-std::size_t bytes_per_pixel(int bits) { return bits > 8 ? 8 : 4; }
-
-// Copies `rect` of a decoded frame into a tightly packed buffer.
-std::vector<std::uint8_t> copy_region(const VideoFrame& frame, const PixelRect& rect) {
-  const std::size_t bpp = bytes_per_pixel(frame.bits);
-  const auto* base = static_cast<const std::uint8_t*>(frame.pixels());
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(rect.width) * rect.height * bpp);
-  for (int y = 0; y < rect.height; ++y)
-    std::memcpy(&out[static_cast<std::size_t>(y) * rect.width * bpp],
-                base + (static_cast<std::size_t>(rect.y + y) * frame.width + rect.x) * bpp,
-                static_cast<std::size_t>(rect.width) * bpp);
-  return out;
-}
-
-std::vector<std::uint8_t> to_rgba8(const Image& image) {
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(image.width()) * image.height() * 4);
-  const float* p = image.data();
-  for (std::size_t i = 0; i < out.size(); ++i)
-    out[i] = static_cast<std::uint8_t>(std::lround(std::clamp(p[i], 0.f, 1.f) * 255.f));
-  return out;
-}
-
-// A source of stereo frames: a decoded file (any layout, pair, alt) or the synthetic clip.
-class StereoFrameSource {
- public:
-  virtual ~StereoFrameSource() = default;
-  virtual std::optional<StereoVideoFrame> next() = 0;
-  virtual double frame_rate() const = 0;
-  virtual std::optional<long> expected_frames() const = 0;
-  // The container whose audio/subtitles are carried over (opened separately), if any.
-  virtual std::string audio_path() const { return {}; }
-  virtual bool has_generated_audio() const { return false; }
-  virtual std::vector<float> generated_audio(std::int64_t, int) const { return {}; }
-  virtual int generated_audio_rate() const { return 0; }
-  virtual void finish_checks(bool /*strict*/) {}
-  // Source time (s) that becomes output time 0.
-  virtual double origin_s() const { return 0.0; }
-};
-
-class SyntheticFrameSource final : public StereoFrameSource {
- public:
-  SyntheticFrameSource(const std::string& spec, double start_s)
-      : clip_(parse_synthetic_spec(spec)), next_(static_cast<int>(std::lround(start_s * clip_.settings().fps))) {}
-  std::optional<StereoVideoFrame> next() override {
-    if (next_ >= clip_.frame_count()) return std::nullopt;
-    const StereoPair pair = clip_.render(next_);
-    StereoVideoFrame f{pair.left.image.width(),
-                       pair.left.image.height(),
-                       8,
-                       to_rgba8(pair.left.image),
-                       to_rgba8(pair.right.image),
-                       pair.left.aspect(),
-                       static_cast<double>(next_ - first_) / clip_.settings().fps};
-    ++next_;
-    return f;
-  }
-  double frame_rate() const override { return clip_.settings().fps; }
-  std::optional<long> expected_frames() const override { return clip_.frame_count() - first_; }
-  bool has_generated_audio() const override { return true; }
-  std::vector<float> generated_audio(std::int64_t first, int count) const override {
-    return clip_.audio(first + static_cast<std::int64_t>(first_) * clip_.settings().audio_rate / clip_.settings().fps,
-                       count);
-  }
-  int generated_audio_rate() const override { return clip_.settings().audio_rate; }
-
- private:
-  SyntheticClip clip_;
-  int next_ = 0;
-  int first_ = next_;
-};
-
-class FileFrameSource final : public StereoFrameSource {
- public:
-  FileFrameSource(const VideoConvertRequest& r) : path_(r.input), source_(open(r.input, r.allow_network)) {
-    if (r.start_s) source_.seek(*r.start_s);
-    pending_ = source_.next_frame();
-    if (!pending_ && r.start_s && source_.info().duration_s && *r.start_s >= *source_.info().duration_s)
-      throw UserError(fmt::format("{}: --start {} is past the end of the video ({:.3g} s)", r.input, *r.start_s,
-                                  *source_.info().duration_s),
-                      1);
-    if (!pending_) throw UserError(fmt::format("{}: no video frame could be decoded", r.input), 1);
-    origin_s_ = source_.info().start_time_s + r.start_s.value_or(0.0);
-    LayoutEvidence evidence;
-    evidence.flag = r.layout;
-    evidence.metadata = source_.stereo_metadata();
-    evidence.width = pending_->width;
-    evidence.height = pending_->height;
-    evidence.filename = r.input;
-    evidence.swap_eyes = r.swap_eyes;
-    evidence.display_aspect = pending_->display_aspect;
-    try {
-      decision_ = detect_stereo_layout(evidence);
-    } catch (const std::exception& e) {
-      throw UserError(fmt::format("{}: {}", r.input, e.what()), 1);
-    }
-    if (!decision_.warning.empty() && !r.quiet) fmt::print(stderr, "nelf: warning: {}\n", decision_.warning);
-    if (decision_.layout == StereoLayout::pair) {
-      if (r.right.empty()) throw UserError("layout pair needs the right view as a second file (--right FILE)", 2);
-      right_.emplace(open(r.right, r.allow_network));
-      if (r.start_s) right_->seek(*r.start_s);
-      const VideoInfo &a = source_.info(), &b = right_->info();
-      if (a.width != b.width || a.height != b.height)
-        throw UserError(fmt::format("pair inputs differ in size: {} is {}x{}, {} is {}x{}", r.input, a.width, a.height,
-                                    r.right, b.width, b.height),
-                        1);
-    } else if (decision_.layout != StereoLayout::alt) {
-      try {
-        regions_ = view_regions(decision_.layout, pending_->width, pending_->height, decision_.swap_eyes,
-                                pending_->display_aspect);
-      } catch (const LayoutError& e) {
-        throw UserError(fmt::format("{}: {}", r.input, e.what()), 1);
-      }
-    }
-    if (!r.quiet)
-      fmt::print(stderr, "nelf: {}: {}x{} {}, layout {}{} ({})\n", r.input, source_.info().width, source_.info().height,
-                 source_.info().video_codec, to_string(decision_.layout), decision_.swap_eyes ? " swapped" : "",
-                 to_string(decision_.rule));
-  }
-
-  std::optional<StereoVideoFrame> next() override {
-    auto frame = take();
-    if (!frame) return std::nullopt;
-    StereoVideoFrame out;
-    out.bits = frame->bits;
-    out.pts_s = frame->pts_s - origin_s_;
-    if (decision_.layout == StereoLayout::alt || decision_.layout == StereoLayout::pair) {
-      auto other = decision_.layout == StereoLayout::alt ? take() : right_->next_frame();
-      if (!other) return std::nullopt;  // an unpaired last view is dropped
-      if (other->width != frame->width || other->height != frame->height || other->bits != frame->bits)
-        throw UserError(fmt::format("{}: the two views of a frame differ in size", path_), 1);
-      const PixelRect whole{0, 0, frame->width, frame->height};
-      out.width = frame->width;
-      out.height = frame->height;
-      out.aspect = frame->display_aspect;
-      out.left = copy_region(*frame, whole);
-      out.right = copy_region(*other, whole);
-      if (decision_.swap_eyes) std::swap(out.left, out.right);
-    } else {
-      if (frame->width != width() || frame->height != height())
-        throw UserError(fmt::format("{}: the frame size changed mid-stream ({}x{} to {}x{})", path_, width(), height(),
-                                    frame->width, frame->height),
-                        1);
-      out.width = regions_.left.width;
-      out.height = regions_.left.height;
-      out.aspect = regions_.display_aspect;
-      out.left = copy_region(*frame, regions_.left);
-      out.right = copy_region(*frame, regions_.right);
-    }
-    return out;
-  }
-
-  double frame_rate() const override {
-    const double fps = source_.info().fps > 0 ? source_.info().fps : 25.0;
-    return decision_.layout == StereoLayout::alt ? fps / 2 : fps;
-  }
-  std::optional<long> expected_frames() const override {
-    const VideoInfo& info = source_.info();
-    std::optional<double> frames;
-    if (info.frame_count)
-      frames = static_cast<double>(*info.frame_count);
-    else if (info.duration_s && info.fps > 0)
-      frames = *info.duration_s * info.fps;
-    if (!frames) return std::nullopt;
-    if (decision_.layout == StereoLayout::alt) *frames /= 2;
-    return static_cast<long>(std::lround(*frames));
-  }
-  std::string audio_path() const override { return path_; }
-  double origin_s() const override { return origin_s_; }
-  void finish_checks(bool strict) override {
-    const std::int64_t lost = source_.stats().problems() + (right_ ? right_->stats().problems() : 0);
-    if (lost == 0) return;
-    const std::string what = fmt::format("{}: damaged or truncated: {} frame(s) lost or damaged", path_, lost);
-    if (strict) throw UserError(what + " (--strict)", 1);
-    fmt::print(stderr, "nelf: warning: {}; converted what decodes\n", what);
-  }
-
- private:
-  static VideoSource open(const std::string& path, bool allow_network) {
-    try {
-      return VideoSource(path, VideoSourceOptions{allow_network, true});
-    } catch (const VideoError& e) {
-      throw UserError(e.what(), 1);
-    }
-  }
-  std::optional<VideoFrame> take() {
-    if (pending_) return std::exchange(pending_, std::nullopt);
-    try {
-      return source_.next_frame();
-    } catch (const VideoError& e) {
-      throw UserError(e.what(), 1);
-    }
-  }
-  int width() const { return source_.info().width; }
-  int height() const { return source_.info().height; }
-
-  std::string path_;
-  VideoSource source_;
-  std::optional<VideoSource> right_;
-  std::optional<VideoFrame> pending_;
-  LayoutDecision decision_;
-  ViewRegions regions_;
-  double origin_s_ = 0.0;
-};
 
 // Where packed frames go: an encoded file or an image sequence.
 class FrameSink {
@@ -524,16 +287,8 @@ bool is_image_sequence_pattern(const std::string& output) {
 
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
-  std::unique_ptr<StereoFrameSource> source;
-  if (is_synthetic_spec(r.input)) {
-    try {
-      source = std::make_unique<SyntheticFrameSource>(r.input, r.start_s.value_or(0.0));
-    } catch (const std::invalid_argument& e) {
-      throw UserError(e.what(), 2);
-    }
-  } else {
-    source = std::make_unique<FileFrameSource>(r);
-  }
+  std::unique_ptr<StereoFrameSource> source = open_stereo_frame_source(
+      StereoSourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network});
 
   // The first frame fixes the view size and depth for the whole run.
   auto first = source->next();
@@ -624,7 +379,11 @@ void convert_video(const VideoConvertRequest& r) {
     composite.join();
     if (interrupted) throw UserError("interrupted: no output written", 130);
     error.rethrow();
-    source->finish_checks(r.strict);
+    if (const std::int64_t lost = source->lost_frames(); lost > 0) {
+      const std::string what = fmt::format("{}: damaged or truncated: {} frame(s) lost or damaged", r.input, lost);
+      if (r.strict) throw UserError(what + " (--strict)", 1);
+      fmt::print(stderr, "nelf: warning: {}; converted what decodes\n", what);
+    }
     sink->finish();
     progress.finish(fmt::format("wrote {}", r.output));
   } catch (...) {

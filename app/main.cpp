@@ -9,8 +9,9 @@
 namespace {
 
 constexpr nelf::app::CommandRegistrar registrars[] = {
-    nelf::app::add_profiles_command, nelf::app::add_design_command,   nelf::app::add_convert_command,
-    nelf::app::add_probe_command,    nelf::app::add_simulate_command, nelf::app::add_calibrate_command,
+    nelf::app::add_profiles_command,  nelf::app::add_design_command,   nelf::app::add_convert_command,
+    nelf::app::add_probe_command,     nelf::app::add_simulate_command, nelf::app::add_play_command,
+    nelf::app::add_calibrate_command,
 };
 
 }  // namespace

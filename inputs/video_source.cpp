@@ -531,7 +531,8 @@ const DecodeStats& VideoSource::stats() const { return impl_->stats; }
 
 void VideoSource::seek(double seconds) {
   Impl& m = *impl_;
-  if (seconds <= 0.0) return;
+  // 0 is a real seek too: a player going back to the start after playing.
+  seconds = std::max(seconds, 0.0);
   const double target = m.info.start_time_s + seconds;
   const auto timestamp = static_cast<std::int64_t>(std::floor(target / av_q2d(m.stream->time_base)));
   if (av_seek_frame(m.format.get(), m.stream->index, timestamp, AVSEEK_FLAG_BACKWARD) < 0)

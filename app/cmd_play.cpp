@@ -1,0 +1,118 @@
+// `nelf play IN`: watch a stereo video on the HMD (or a preview window) with sound: the player
+// engine (hmz_output/player) on the display --output picks.
+#include <fmt/format.h>
+
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include "app/commands.hpp"
+#include "app/interrupt.hpp"
+#include "hmz_output/display.hpp"
+#include "hmz_output/kms_display.hpp"
+#include "hmz_output/player.hpp"
+#include "hmz_output/window_display.hpp"
+#include "inputs/stereo_frame_source.hpp"
+#include "inputs/still_source.hpp"
+#include "inputs/video_source.hpp"
+
+namespace nelf::app {
+namespace {
+
+struct PlayArgs : CommonArgs {
+  std::string output = "window";
+  std::string monitor;
+  std::string connector;
+  bool no_audio = false;
+  bool quiet = false;
+  std::string log_frames;
+};
+
+std::unique_ptr<Display> open_display(const DisplayOptions& options) {
+  switch (options.kind) {
+    case OutputKind::window:
+    case OutputKind::fullscreen:
+    case OutputKind::quad_buffer: {
+      try {
+        return open_window_display(options);
+      } catch (const std::exception& e) {
+        throw UserError(e.what(), 1);
+      }
+    }
+    case OutputKind::kms:
+      try {
+        return open_kms_display(options);
+      } catch (const std::exception& e) {
+        throw UserError(e.what(), 1);
+      }
+  }
+  throw UserError("unknown output", 2);
+}
+
+void run_play(const PlayArgs& args) {
+  quiet_ffmpeg_logs(true);
+  CommonOptions common = parse_common_options(args, false);
+  OutputKind kind;
+  try {
+    kind = parse_output_kind(args.output);
+  } catch (const std::invalid_argument& e) {
+    throw UserError(e.what(), 2);
+  }
+  if (!args.monitor.empty() && kind != OutputKind::fullscreen)
+    throw UserError("--monitor chooses the monitor for --output fullscreen", 2);
+  if (!args.connector.empty() && kind != OutputKind::kms)
+    throw UserError("--connector chooses the HDMI connector for --output kms", 2);
+
+  StereoSourceRequest request;
+  request.input = args.input;
+  request.right = args.right;
+  request.layout = args.right.empty() ? common.layout : StereoLayout::pair;
+  request.swap_eyes = args.swap_eyes;
+  request.quiet = args.quiet;
+  request.allow_network = args.allow_network;
+  const auto source = open_stereo_frame_source(request);
+
+  PlayerOptions options;
+  options.profile = common.profile;
+  options.signal = common.signal;
+  options.compositor = common.compositor;
+  options.audio = !args.no_audio;
+  options.allow_network = args.allow_network;
+  options.log_frames = args.log_frames;
+  options.quiet = args.quiet;
+
+  DisplayOptions display_options;
+  display_options.kind = kind;
+  display_options.signal = common.signal;
+  const auto panel = common.profile.display.resolution;
+  display_options.packed = {common.signal.packed_width(panel[0]), common.signal.packed_height(panel[1])};
+  display_options.monitor = args.monitor;
+  display_options.connector = args.connector;
+  display_options.title = fmt::format("nelf: {}", args.input);
+  const auto display = open_display(display_options);
+  if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", display->description());
+
+  InterruptGuard guard;
+  const PlayResult result = play(*display, *source, options, &interrupted);
+  fmt::print(stderr, "nelf: {}\n", play_summary(result));
+  if (result.end == PlayEnd::interrupted) throw UserError("interrupted", 130);
+}
+
+}  // namespace
+
+void add_play_command(CLI::App& app) {
+  auto args = std::make_shared<PlayArgs>();
+  auto* cmd = app.add_subcommand("play", "Watch a stereo video on the display (HMD over HDMI, or a preview window)");
+  add_common_options(*cmd, *args);
+  cmd->add_option("--output", args->output, "Where to show it: window, fullscreen, kms or quad-buffer")
+      ->capture_default_str();
+  cmd->add_option("--monitor", args->monitor, "fullscreen: the monitor (default: the one named like HMZ)");
+  cmd->add_option("--connector", args->connector, "kms: the connector, e.g. HDMI-A-1 (default: the first with 3D)");
+  cmd->add_flag("--no-audio", args->no_audio, "Play without sound (the system clock paces the video)");
+  cmd->add_flag("--quiet", args->quiet, "Only the summary line at exit");
+  cmd->add_option("--log-frames", args->log_frames,
+                  "Diagnostics: write a CSV line per presented refresh (pts, clock, audio clock, counters)");
+  cmd->callback([args] { run_play(*args); });
+}
+
+}  // namespace nelf::app

@@ -1,0 +1,100 @@
+#pragma once
+// Sound for `nelf play` through SDL2 audio, and the clock playback follows (DESIGN.md §7).
+//
+// With sound, the AUDIO CLOCK is master: the presentation time of the sample being heard now =
+// the pts just past the last sample handed to SDL, minus what SDL still holds in its queue, minus
+// the device buffer (SDL pulls whole buffers; between pulls the clock is interpolated with the
+// system clock, at most one buffer ahead, so that it advances smoothly instead of in 10 ms steps).
+// Without sound (no audio device, no audio stream, --no-audio) a monotonic SystemClock is master.
+#include <SDL2/SDL.h>
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "inputs/audio_source.hpp"
+
+namespace nelf {
+
+// The master clock of playback, in seconds on the pts timeline. Thread-safe.
+class PlaybackClock {
+ public:
+  virtual ~PlaybackClock() = default;
+  virtual double now() const = 0;
+  virtual void set_paused(bool paused) = 0;
+  virtual bool paused() const = 0;
+  // After a seek: the clock continues from `seconds` (audio: once the new samples play).
+  virtual void restart_at(double seconds) = 0;
+};
+
+// Monotonic system time, pausable, starting at 0 (or where restart_at puts it).
+class SystemClock final : public PlaybackClock {
+ public:
+  using Clock = std::chrono::steady_clock;
+  SystemClock();
+  double now() const override;
+  void set_paused(bool paused) override;
+  bool paused() const override;
+  void restart_at(double seconds) override;
+
+ private:
+  double now_locked() const;
+  mutable std::mutex mutex_;
+  Clock::time_point origin_;  // system time at which the clock read base_
+  double base_ = 0.0;
+  bool paused_ = false;
+};
+
+// An open SDL audio device playing interleaved float stereo. Starts paused until the first
+// set_paused(false).
+class AudioOutput final : public PlaybackClock {
+ public:
+  // Opens the default output device (SDL_AUDIODRIVER picks the driver) at `sample_rate`, or says
+  // why not in `why_not` and returns null: no audio subsystem, no device.
+  static std::unique_ptr<AudioOutput> open(int sample_rate, std::string& why_not);
+  ~AudioOutput() override;
+  AudioOutput(const AudioOutput&) = delete;
+  AudioOutput& operator=(const AudioOutput&) = delete;
+
+  int sample_rate() const { return spec_.freq; }
+  // "pulseaudio, 48000 Hz, 512-sample buffer"
+  std::string description() const;
+
+  // Appends samples. A chunk starting later than the end of what was queued is preceded by silence
+  // (so that the clock stays on the pts timeline); one starting earlier is queued as it is.
+  void queue(const AudioChunk& chunk);
+  // Seconds of sound queued and not yet heard.
+  double buffered_s() const;
+  // No more samples will come: once the queue runs dry the clock goes on with the system clock
+  // instead of stopping (video longer than audio).
+  void end_of_stream();
+
+  double now() const override;
+  void set_paused(bool paused) override;
+  bool paused() const override;
+  // Drops everything queued (a seek); the clock holds at `seconds` until new samples play.
+  void restart_at(double seconds) override;
+
+ private:
+  AudioOutput(SDL_AudioDeviceID device, const SDL_AudioSpec& spec);
+  double now_locked() const;
+
+  SDL_AudioDeviceID device_;
+  SDL_AudioSpec spec_;
+  mutable std::mutex mutex_;
+  std::optional<double> queued_end_pts_;  // pts just past the last queued sample
+  double hold_pts_ = 0.0;                 // the clock before any sample was queued
+  bool paused_ = true;
+  bool end_of_stream_ = false;
+  // Smoothing: the last computed clock, when it changed, and what the queue held then.
+  mutable std::uint32_t last_queued_bytes_ = 0;
+  mutable double last_clock_ = 0.0;
+  mutable std::chrono::steady_clock::time_point last_change_{};
+  mutable std::optional<std::chrono::steady_clock::time_point> drained_at_;
+  mutable double drained_base_ = 0.0;
+};
+
+}  // namespace nelf

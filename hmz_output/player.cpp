@@ -1,0 +1,663 @@
+#include "hmz_output/player.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "compositor/gl/objects.hpp"
+#include "compositor/gl_compositor.hpp"
+#include "compositor/text_overlay.hpp"
+#include "hmz_output/audio_output.hpp"
+#include "hmz_output/packing.hpp"
+#include "inputs/audio_source.hpp"
+#include "inputs/test_patterns.hpp"
+#include "inputs/user_error.hpp"
+
+namespace nelf {
+
+namespace {
+
+using Steady = std::chrono::steady_clock;
+double seconds_since(Steady::time_point t) { return std::chrono::duration<double>(Steady::now() - t).count(); }
+
+// Decoded frames waiting for their refresh. The decode thread fills it up to `capacity`; a seek
+// empties it and bumps the generation so that a frame decoded before the seek is never queued.
+class FrameQueue {
+ public:
+  explicit FrameQueue(std::size_t capacity) : capacity_(capacity) {}
+
+  // Decode thread: waits for room (or a seek, or stop). Returns the seek target if one is pending.
+  struct Work {
+    std::optional<double> seek_to;
+    std::uint64_t generation = 0;
+    bool stop = false;
+  };
+  Work wait_for_work() {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return stop_ || seek_to_ || (!end_ && items_.size() < capacity_); });
+    Work work{std::exchange(seek_to_, std::nullopt), generation_, stop_};
+    return work;
+  }
+  void push(StereoVideoFrame frame, std::uint64_t generation) {
+    std::lock_guard lock(mutex_);
+    if (generation != generation_) return;  // decoded before a seek
+    items_.push_back(std::move(frame));
+    changed_.notify_all();
+  }
+  void set_end(std::uint64_t generation) {
+    std::lock_guard lock(mutex_);
+    if (generation == generation_) end_ = true;
+    changed_.notify_all();
+  }
+  void fail(std::exception_ptr error) {
+    std::lock_guard lock(mutex_);
+    error_ = error;
+    end_ = true;
+    changed_.notify_all();
+  }
+
+  // Render thread.
+  void seek(double seconds) {
+    std::lock_guard lock(mutex_);
+    seek_to_ = seconds;
+    ++generation_;
+    items_.clear();
+    end_ = false;
+    changed_.notify_all();
+  }
+  void stop() {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+    changed_.notify_all();
+  }
+  // pts of the queued frames and whether the stream has ended; rethrows the decoder's failure.
+  std::vector<double> snapshot(bool& end) {
+    std::lock_guard lock(mutex_);
+    if (error_) std::rethrow_exception(error_);
+    std::vector<double> pts;
+    pts.reserve(items_.size());
+    for (const auto& f : items_) pts.push_back(f.pts_s);
+    end = end_ && !seek_to_;
+    return pts;
+  }
+  // Removes `drop` frames, then returns the next one if `take`.
+  std::optional<StereoVideoFrame> pop(std::size_t drop, bool take) {
+    std::lock_guard lock(mutex_);
+    for (std::size_t i = 0; i < drop && !items_.empty(); ++i) items_.pop_front();
+    std::optional<StereoVideoFrame> out;
+    if (take && !items_.empty()) {
+      out = std::move(items_.front());
+      items_.pop_front();
+    }
+    changed_.notify_all();
+    return out;
+  }
+  // Waits up to `timeout` for a frame (or the end); true when one is there.
+  bool wait_for_frame(std::chrono::milliseconds timeout) {
+    std::unique_lock lock(mutex_);
+    changed_.wait_for(lock, timeout, [&] { return !items_.empty() || end_ || error_; });
+    if (error_) std::rethrow_exception(error_);
+    return !items_.empty();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<StereoVideoFrame> items_;
+  std::size_t capacity_;
+  std::optional<double> seek_to_;
+  std::uint64_t generation_ = 0;
+  bool end_ = false, stop_ = false;
+  std::exception_ptr error_;
+};
+
+// The decode thread: fills the queue, follows seeks. Frames whose time passes while they wait are
+// dropped by the scheduler. (Skipping late frames here as well was measured and is worse when
+// decoding is the bottleneck: each decoded frame is late, so most were thrown away without the
+// decoder catching up; jumping ahead by seeking is worse still with long GOPs.)
+void decode_loop(StereoFrameSource& source, FrameQueue& queue) {
+  try {
+    for (;;) {
+      const FrameQueue::Work work = queue.wait_for_work();
+      if (work.stop) return;
+      if (work.seek_to) {
+        source.seek(*work.seek_to);
+        continue;
+      }
+      auto frame = source.next();
+      if (!frame) {
+        queue.set_end(work.generation);
+        continue;
+      }
+      queue.push(std::move(*frame), work.generation);
+    }
+  } catch (...) {
+    queue.fail(std::current_exception());
+  }
+}
+
+// Feeds decoded audio to the device, about half a second ahead, until stopped.
+class AudioFeeder {
+ public:
+  AudioFeeder(AudioSource source, AudioOutput& output) : source_(std::move(source)), output_(output) {
+    thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
+  }
+  ~AudioFeeder() {
+    thread_.request_stop();
+    wake_.notify_all();
+  }
+  AudioFeeder(const AudioFeeder&) = delete;
+  AudioFeeder& operator=(const AudioFeeder&) = delete;
+
+  // Render thread: drop what is queued and continue from `seconds`.
+  void seek(double seconds) {
+    std::lock_guard lock(mutex_);
+    output_.restart_at(seconds);
+    seek_to_ = seconds;
+    ++generation_;
+    ended_ = false;
+    wake_.notify_all();
+  }
+  std::int64_t decode_errors() const { return errors_.load(); }
+
+ private:
+  void run(std::stop_token stop) {
+    while (!stop.stop_requested()) {
+      std::uint64_t generation;
+      {
+        std::unique_lock lock(mutex_);
+        if (seek_to_) {
+          try {
+            source_.seek(*std::exchange(seek_to_, std::nullopt));
+          } catch (const AudioError&) {
+            ended_ = true;  // a file that cannot seek its audio plays on without it
+            output_.end_of_stream();
+          }
+        }
+        if (ended_) {
+          wake_.wait_for(lock, std::chrono::milliseconds(50));
+          continue;
+        }
+        generation = generation_;
+      }
+      if (output_.buffered_s() > 0.5) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        continue;
+      }
+      std::optional<AudioChunk> chunk;
+      try {
+        chunk = source_.next();
+      } catch (const AudioError&) {
+        chunk.reset();  // the audio is beyond repair: the video goes on, on the clock the sound left
+      }
+      errors_.store(source_.decode_errors());
+      std::lock_guard lock(mutex_);
+      if (generation != generation_) continue;  // decoded before a seek
+      if (!chunk) {
+        ended_ = true;
+        output_.end_of_stream();
+        continue;
+      }
+      output_.queue(*chunk);
+    }
+  }
+
+  AudioSource source_;
+  AudioOutput& output_;
+  std::mutex mutex_;
+  std::condition_variable_any wake_;
+  std::optional<double> seek_to_;
+  std::uint64_t generation_ = 0;
+  bool ended_ = false;
+  std::atomic<std::int64_t> errors_{0};
+  std::jthread thread_;  // last: stops before the members it uses go
+};
+
+// The calibration overlay: `nelf calibrate`'s grid pattern (lines 16 cells across, a yellow centre
+// cross, the eye's letter) drawn over the view, so that the eyes' alignment and the lens grid can
+// be judged on the movie itself. `pattern` is the grid as RGBA float at the view's size.
+void draw_over(std::vector<std::uint8_t>& pixels, const Image& pattern, int bits) {
+  const std::size_t n = static_cast<std::size_t>(pattern.width()) * pattern.height();
+  const float* p = pattern.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const float r = p[i * 4], g = p[i * 4 + 1], b = p[i * 4 + 2];
+    if (std::max({r, g, b}) < 0.02f) continue;  // black: the movie shows through
+    const float rgb[3] = {r, g, b};
+    for (int c = 0; c < 3; ++c) {
+      const float v = std::clamp(rgb[c], 0.f, 1.f);
+      if (bits > 8) {
+        const auto u = static_cast<std::uint16_t>(std::lround(v * 65535.f));
+        std::memcpy(&pixels[i * 8 + static_cast<std::size_t>(c) * 2], &u, 2);
+      } else {
+        pixels[i * 4 + static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(std::lround(v * 255.f));
+      }
+    }
+  }
+}
+
+// The GL side: view textures, the compositor (rebuilt when the optics change) and the eye areas.
+class PackedRenderer {
+ public:
+  PackedRenderer(Display& display, const PlayerOptions& options) : display_(display), options_(options) {
+    profile_ = options.profile;
+    rebuild();
+  }
+
+  // Throws (and keeps the old compositor) when the profile is not usable.
+  void set_profile(const Profile& profile) {
+    const Profile previous = profile_;
+    profile_ = profile;
+    try {
+      rebuild();
+    } catch (...) {
+      profile_ = previous;
+      rebuild();
+      throw;
+    }
+  }
+  const Profile& profile() const { return profile_; }
+
+  void upload(const StereoVideoFrame& frame, bool calibration) {
+    if (frame.width != view_w_ || frame.height != view_h_ || frame.bits != bits_) {
+      view_w_ = frame.width;
+      view_h_ = frame.height;
+      bits_ = frame.bits;
+      for (auto& t : views_) t = gl::make_texture_2d(bits_ > 8 ? GL_RGBA16 : GL_RGBA8, view_w_, view_h_);
+    }
+    aspect_ = frame.aspect;
+    const GLenum type = bits_ > 8 ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE;
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    for (int i = 0; i < 2; ++i) {
+      const auto& source = i == 0 ? frame.left : frame.right;
+      if (calibration) {
+        std::vector<std::uint8_t> copy = source;
+        draw_over(copy, calibration_grid(i), bits_);
+        glTextureSubImage2D(views_[i].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, copy.data());
+      } else {
+        glTextureSubImage2D(views_[i].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, source.data());
+      }
+    }
+    gl::check_error("uploading the views");
+  }
+
+  // The grid for view `i` at the current view size and optics (made when first needed).
+  const Image& calibration_grid(int i) {
+    const PatternGeometry geometry = pattern_geometry(profile_, view_w_, view_h_);
+    if (!grid_ || !(grid_geometry_ == geometry)) {
+      grid_ = make_test_pattern(TestPattern::grid, geometry);
+      grid_geometry_ = geometry;
+    }
+    return i == 0 ? grid_->left.image : grid_->right.image;
+  }
+
+  // The on-screen message ("" for none), blended into both views before compositing so that it
+  // is seen in focus through the lenses.
+  void set_message(const std::string& text) { overlay_.set_text(text); }
+
+  // Both eyes into the display's packed framebuffer; the gap (and any border) black.
+  void render(bool swap_eyes) {
+    const GLuint fbo = display_.packed_framebuffer();
+    const float black[4] = {0.f, 0.f, 0.f, 1.f};
+    glClearNamedFramebufferfv(fbo, GL_COLOR, 0, black);
+    if (view_w_ == 0) return;
+    for (Eye eye : {Eye::left, Eye::right}) {
+      const auto& origin = origins_[static_cast<int>(eye)];
+      if (!origin) continue;
+      const int view = static_cast<int>(eye) ^ (swap_eyes ? 1 : 0);
+      const GlTextureView shown = overlay_.apply(eye, GlTextureView{views_[view].id(), view_w_, view_h_, aspect_});
+      compositor_->render_eye(eye, shown, GlTarget{fbo, origin->first, origin->second});
+    }
+  }
+
+ private:
+  void rebuild() {
+    compositor_.reset();
+    compositor_ = std::make_unique<GlCompositor>(profile_, options_.compositor, display_.context());
+    const auto panel = compositor_->panel();
+    const auto packed = display_.packed_size();
+    for (Eye eye : {Eye::left, Eye::right}) {
+      const auto area = eye_area(options_.signal, eye, panel[0], panel[1]);
+      origins_[static_cast<int>(eye)].reset();
+      if (!area) continue;
+      if (panel[0] > area->width || panel[1] > area->height)
+        throw UserError(fmt::format("the {}x{} panel of profile {} does not fit the {}x{} eye area of signal {}",
+                                    panel[0], panel[1], profile_.name, area->width, area->height, options_.signal.name),
+                        2);
+      const int x = area->x + (area->width - panel[0]) / 2, y = area->y + (area->height - panel[1]) / 2;
+      if (x + panel[0] > packed[0] || y + panel[1] > packed[1])
+        throw UserError(fmt::format("the display's {}x{} frame is smaller than signal {} needs", packed[0], packed[1],
+                                    options_.signal.name),
+                        1);
+      origins_[static_cast<int>(eye)] = std::pair{x, y};
+    }
+  }
+
+  Display& display_;
+  const PlayerOptions& options_;
+  Profile profile_;
+  std::unique_ptr<GlCompositor> compositor_;
+  TextOverlay overlay_;
+  std::optional<StereoPair> grid_;
+  PatternGeometry grid_geometry_;
+  std::array<std::optional<std::pair<int, int>>, 2> origins_;
+  std::array<gl::Texture, 2> views_;
+  int view_w_ = 0, view_h_ = 0, bits_ = 8;
+  double aspect_ = 0.0;
+};
+
+class FrameLog {
+ public:
+  explicit FrameLog(const std::string& path) {
+    if (path.empty()) return;
+    file_ = std::fopen(path.c_str(), "w");
+    if (!file_) throw UserError(fmt::format("{}: cannot write the frame log", path), 1);
+    std::fputs("refresh,event,pts_s,clock_s,audio_clock_s,shown,repeated,dropped,upload_ms,render_ms,present_ms\n",
+               file_);
+  }
+  ~FrameLog() {
+    if (file_) std::fclose(file_);
+  }
+  FrameLog(const FrameLog&) = delete;
+  FrameLog& operator=(const FrameLog&) = delete;
+  bool enabled() const { return file_ != nullptr; }
+  // Times in seconds; what was not done this refresh is 0.
+  void write(std::int64_t refresh, const char* event, std::optional<double> pts, double clock,
+             std::optional<double> audio_clock, const FrameCounters& c, double upload_s, double render_s,
+             double present_s) {
+    if (!file_) return;
+    std::fprintf(file_, "%lld,%s,%s,%.6f,%s,%lld,%lld,%lld,%.2f,%.2f,%.2f\n", static_cast<long long>(refresh), event,
+                 pts ? fmt::format("{:.6f}", *pts).c_str() : "", clock,
+                 audio_clock ? fmt::format("{:.6f}", *audio_clock).c_str() : "", static_cast<long long>(c.shown),
+                 static_cast<long long>(c.repeated), static_cast<long long>(c.dropped), upload_s * 1e3, render_s * 1e3,
+                 present_s * 1e3);
+  }
+
+ private:
+  std::FILE* file_ = nullptr;
+};
+
+}  // namespace
+
+std::string play_summary(const PlayResult& r) {
+  std::string line = fmt::format("{} frames shown, {} repeated, {} dropped", r.counters.shown, r.counters.repeated,
+                                 r.counters.dropped);
+  if (r.video_decode_errors > 0) line += fmt::format(", {} video frames lost to decode errors", r.video_decode_errors);
+  if (r.audio_decode_errors > 0) line += fmt::format(", {} audio decode errors", r.audio_decode_errors);
+  return line;
+}
+
+PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions& options,
+                const std::atomic<bool>* stop) {
+  PlayResult result;
+  display.context()->make_current();
+  PackedRenderer renderer(display, options);
+  FrameLog log(options.log_frames);
+
+  // The master clock: the sound's when there is sound.
+  std::unique_ptr<AudioOutput> audio;
+  std::unique_ptr<AudioFeeder> feeder;
+  SystemClock system_clock;
+  PlaybackClock* clock = &system_clock;
+  if (!options.audio) {
+    result.sound = "--no-audio";
+  } else if (source.has_generated_audio()) {
+    result.sound = "the synthetic clip's tone is not played";
+  } else if (source.audio_path().empty()) {
+    result.sound = "no audio stream";
+  } else {
+    std::optional<AudioSource> audio_source;
+    try {
+      audio_source.emplace(source.audio_path(),
+                           AudioSourceOptions{options.audio_rate, source.origin_s(), options.allow_network});
+    } catch (const AudioError& e) {
+      result.sound = std::string(e.what()).find("no audio stream") != std::string::npos
+                         ? "no audio stream"
+                         : fmt::format("the audio cannot be decoded ({})", e.what());
+    }
+    if (audio_source) {
+      std::string why_not;
+      audio = AudioOutput::open(audio_source->sample_rate(), why_not);
+      if (!audio) {
+        result.sound = fmt::format("no audio device ({})", why_not);
+      } else {
+        // The device may run at another rate: decode for the rate it has.
+        if (audio->sample_rate() != audio_source->sample_rate())
+          audio_source.emplace(source.audio_path(),
+                               AudioSourceOptions{audio->sample_rate(), source.origin_s(), options.allow_network});
+        result.had_sound = true;
+        result.sound = audio->description();
+        clock = audio.get();
+        feeder = std::make_unique<AudioFeeder>(std::move(*audio_source), *audio);
+      }
+    }
+  }
+  if (!options.quiet) {
+    if (result.had_sound)
+      std::fprintf(stderr, "nelf: sound: %s\n", result.sound.c_str());
+    else
+      std::fprintf(stderr, "nelf: %s: playing without sound\n", result.sound.c_str());
+  }
+  clock->set_paused(true);  // starts with the first frame on screen
+
+  const double refresh_period = 1.0 / display.refresh_hz();
+  const double fps = source.frame_rate();
+  FrameScheduler scheduler(refresh_period, fps > 0 ? 1.0 / fps : 0.0);
+  FrameQueue queue(6);
+  std::jthread decoder([&] { decode_loop(source, queue); });
+  struct StopDecoder {
+    FrameQueue& queue;
+    ~StopDecoder() { queue.stop(); }
+  } stop_decoder{queue};
+
+  const auto duration = source.duration_s();
+
+  bool paused = false, started = false, calibration = false, swap_eyes = false, dirty = false;
+  bool awaiting_seek = false;
+  bool show_while_paused = false;  // a seek while paused shows the first frame at the new place
+  std::optional<StereoVideoFrame> current;
+  std::string message;
+  Steady::time_point message_until{};
+  // Time from the decision to the end of present(): the median of the last few renders (the first,
+  // which compiles shaders, does not count), so one slow frame on a loaded machine does not make
+  // the next ones come early.
+  std::deque<double> render_times;
+  double render_s = refresh_period;
+  std::int64_t refresh = 0;
+  auto next_tick = Steady::now();
+
+  auto say = [&](std::string text) {
+    message = std::move(text);
+    renderer.set_message(message);
+    message_until = Steady::now() + std::chrono::seconds(2);
+    dirty = true;
+  };
+  auto seek_by = [&](double delta) {
+    const double from = current ? current->pts_s : clock->now();
+    double target = std::max(0.0, from + delta);
+    if (duration) target = std::min(target, std::max(0.0, *duration - 0.001));
+    queue.seek(target);
+    if (feeder) feeder->seek(target);
+    clock->restart_at(target);
+    clock->set_paused(true);  // until the first frame after the seek is decoded
+    awaiting_seek = true;
+    scheduler.reset();
+    say(fmt::format("{} {:.0f} s: {}:{:02d}", delta < 0 ? "back" : "forward", std::abs(delta),
+                    static_cast<int>(target) / 60, static_cast<int>(target) % 60));
+  };
+  auto change_profile = [&](Profile changed, const std::string& what) {
+    try {
+      renderer.set_profile(changed);
+      dirty = true;
+      say(what);
+    } catch (const std::exception& e) {
+      say(fmt::format("cannot: {}", e.what()));
+    }
+  };
+
+  // Wait (briefly) for the first frame so the clock does not run ahead of a slow start.
+  while (!queue.wait_for_frame(std::chrono::milliseconds(50))) {
+    bool end = false;
+    queue.snapshot(end);
+    if (end || (stop && stop->load()) || display.close_requested()) break;
+    display.poll_events();
+  }
+
+  for (;;) {
+    for (const KeyPress& key : display.poll_events()) {
+      if (key.is(KeyPress::Named::escape) || key.is(U'q') || key.is(U'Q')) {
+        result.end = PlayEnd::quit_key;
+      } else if (key.is(KeyPress::Named::space)) {
+        paused = !paused;
+        if (!awaiting_seek && started) clock->set_paused(paused);
+        say(paused ? "paused" : "playing");
+      } else if (key.is(KeyPress::Named::left)) {
+        seek_by(-10);
+      } else if (key.is(KeyPress::Named::right)) {
+        seek_by(10);
+      } else if (key.is(KeyPress::Named::up)) {
+        seek_by(60);
+      } else if (key.is(KeyPress::Named::down)) {
+        seek_by(-60);
+      } else if (key.is(U'+') || key.is(U'=') || key.is(U'-') || key.is(U'_')) {
+        Profile p = renderer.profile();
+        const double now_mm = p.screen.distance_mm > 0 ? p.screen.distance_mm : p.viewing.virtual_image_mm;
+        p.screen.distance_mm = (key.is(U'-') || key.is(U'_')) ? now_mm / 1.25 : now_mm * 1.25;
+        change_profile(p, fmt::format("screen distance {:.0f} mm", p.screen.distance_mm));
+      } else if (key.is(U'[') || key.is(U']')) {
+        Profile p = renderer.profile();
+        p.viewing.ipd_mm += key.is(U'[') ? -0.5 : 0.5;
+        change_profile(p, fmt::format("IPD {:.1f} mm", p.viewing.ipd_mm));
+      } else if (key.is(U's') || key.is(U'S')) {
+        swap_eyes = !swap_eyes;
+        dirty = true;
+        say(swap_eyes ? "eyes swapped" : "eyes as the source says");
+      } else if (key.is(U'c') || key.is(U'C')) {
+        calibration = !calibration;
+        try {
+          if (current) renderer.upload(*current, calibration);
+        } catch (const TestPatternError& e) {
+          calibration = false;
+          if (current) renderer.upload(*current, calibration);
+          say(fmt::format("no calibration grid: {}", e.what()));
+          continue;
+        }
+        dirty = true;
+        say(calibration ? "calibration grid on" : "calibration grid off");
+      } else if (key.is(U'f') || key.is(U'F')) {
+        say(display.toggle_fullscreen());
+        dirty = true;
+      }
+    }
+    if (result.end == PlayEnd::quit_key) break;
+    if (display.close_requested()) {
+      result.end = PlayEnd::window_closed;
+      break;
+    }
+    if (stop && stop->load()) {
+      result.end = PlayEnd::interrupted;
+      break;
+    }
+
+    const auto decided_at = Steady::now();
+    const char* event = nullptr;
+    double upload_s = 0.0, render_only_s = 0.0, present_s = 0.0;
+    bool end = false;
+    std::vector<double> queued = queue.snapshot(end);
+    if (awaiting_seek && (!queued.empty() || end)) {
+      awaiting_seek = false;
+      show_while_paused = paused;
+      if (!paused) clock->set_paused(false);
+    }
+    bool finished = false;
+    if (!awaiting_seek && (!(paused && started) || show_while_paused)) {
+      // When this refresh will be seen: after the next vblank, or once rendered and presented.
+      const double visible_at = clock->now() + (display.vsync() ? refresh_period : render_s);
+      const FrameDecision d = scheduler.decide(visible_at, queued, end);
+      if (d.drop > 0 || d.show_front) {
+        auto frame = queue.pop(d.drop, d.show_front);
+        if (frame) {
+          show_while_paused = false;
+          current = std::move(frame);
+          const auto t = Steady::now();
+          renderer.upload(*current, calibration);
+          if (log.enabled()) glFinish();  // so that the log says where the time goes
+          upload_s = seconds_since(t);
+          dirty = true;
+          event = "shown";
+        }
+      }
+      if (d.repeat) event = "repeated";
+      finished = d.finished;
+    }
+    if (!message.empty() && Steady::now() > message_until) {
+      message.clear();
+      renderer.set_message("");
+      dirty = true;
+    }
+    if (finished) break;
+
+    if (dirty) {
+      auto t = Steady::now();
+      renderer.render(swap_eyes);
+      if (log.enabled()) glFinish();
+      render_only_s = seconds_since(t);
+      if (options.after_render) options.after_render(display, current ? current->pts_s : 0.0);
+      t = Steady::now();
+      try {
+        display.present();
+      } catch (const std::runtime_error& e) {
+        throw UserError(fmt::format("the display was lost: {}", e.what()), 1);
+      }
+      present_s = seconds_since(t);
+      dirty = false;
+      if (started) {
+        render_times.push_back(seconds_since(decided_at));
+        if (render_times.size() > 9) render_times.pop_front();
+        std::vector<double> sorted(render_times.begin(), render_times.end());
+        std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+        render_s = sorted[sorted.size() / 2];
+      }
+      if (!started) {
+        started = true;
+        if (!paused && !awaiting_seek) clock->set_paused(false);
+      }
+      if (!event) event = "redrawn";
+    } else if (display.vsync()) {
+      display.present();  // paces the loop at the refresh
+    }
+    if (event)
+      log.write(refresh, event, current ? std::optional(current->pts_s) : std::nullopt, clock->now(),
+                audio ? std::optional(audio->now()) : std::nullopt, scheduler.counters(), upload_s, render_only_s,
+                present_s);
+    ++refresh;
+
+    if (!display.vsync()) {
+      next_tick += std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(refresh_period));
+      const auto now = Steady::now();
+      if (next_tick < now - std::chrono::milliseconds(100)) next_tick = now;  // far behind: do not race
+      std::this_thread::sleep_until(next_tick);
+    }
+  }
+
+  queue.stop();
+  decoder.join();
+  if (feeder) result.audio_decode_errors = feeder->decode_errors();
+  feeder.reset();
+  result.counters = scheduler.counters();
+  result.video_decode_errors = source.lost_frames();
+  return result;
+}
+
+}  // namespace nelf

@@ -1,0 +1,213 @@
+#include "inputs/audio_source.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+extern "C" {
+#include <libavcodec/avcodec.h>
+#include <libavformat/avformat.h>
+#include <libavutil/channel_layout.h>
+#include <libswresample/swresample.h>
+}
+
+#include "inputs/ffmpeg_raii.hpp"
+
+namespace nelf {
+
+namespace {
+
+struct SwrContextDeleter {
+  void operator()(SwrContext* s) const { swr_free(&s); }
+};
+using SwrContextPtr = std::unique_ptr<SwrContext, SwrContextDeleter>;
+
+bool is_url(const std::string& path) { return path.find("://") != std::string::npos || path.rfind("pipe:", 0) == 0; }
+
+}  // namespace
+
+struct AudioSource::Impl {
+  std::string path;
+  AudioSourceOptions options;
+  ffmpeg::FormatContextPtr format;
+  ffmpeg::CodecContextPtr codec;
+  ffmpeg::PacketPtr packet{av_packet_alloc()};
+  ffmpeg::FramePtr frame{av_frame_alloc()};
+  SwrContextPtr swr;
+  AVStream* stream = nullptr;
+  bool draining = false, finished = false;
+  std::int64_t errors = 0;
+  int consecutive_errors = 0;
+  std::optional<double> cut_before;  // after a seek: drop samples before this time
+  std::optional<double> next_pts;    // continues the timeline when a frame has no timestamp
+
+  [[noreturn]] void fail(const std::string& why) const { throw AudioError(fmt::format("{}: {}", path, why)); }
+
+  void open(const std::string& p, const AudioSourceOptions& o) {
+    path = p;
+    options = o;
+    if (options.sample_rate <= 0) fail("the audio sample rate must be > 0");
+    const std::string url = is_url(path) ? path : "file:" + path;
+    AVDictionary* raw_options = nullptr;
+    // The same rule as VideoSource (DESIGN.md §11): no network unless asked for.
+    if (!options.allow_network) av_dict_set(&raw_options, "protocol_whitelist", "file,pipe", 0);
+    AVFormatContext* raw = nullptr;
+    const int opened = avformat_open_input(&raw, url.c_str(), nullptr, &raw_options);
+    ffmpeg::DictionaryPtr unused(raw_options);
+    if (opened < 0) fail(fmt::format("cannot open: {}", ffmpeg::error_string(opened)));
+    format.reset(raw);
+    if (const int found = avformat_find_stream_info(format.get(), nullptr); found < 0)
+      fail(fmt::format("not a readable media file: {}", ffmpeg::error_string(found)));
+    const AVCodec* decoder = nullptr;
+    const int best = av_find_best_stream(format.get(), AVMEDIA_TYPE_AUDIO, -1, -1, &decoder, 0);
+    if (best == AVERROR_STREAM_NOT_FOUND) fail("no audio stream");
+    if (best < 0 || !decoder) fail(fmt::format("no decoder for the audio stream: {}", ffmpeg::error_string(best)));
+    stream = format->streams[best];
+    for (unsigned i = 0; i < format->nb_streams; ++i)
+      if (static_cast<int>(i) != best) format->streams[i]->discard = AVDISCARD_ALL;
+    codec.reset(avcodec_alloc_context3(decoder));
+    if (!codec) fail("out of memory");
+    if (avcodec_parameters_to_context(codec.get(), stream->codecpar) < 0) fail("bad audio stream parameters");
+    codec->pkt_timebase = stream->time_base;
+    if (const int r = avcodec_open2(codec.get(), decoder, nullptr); r < 0)
+      fail(fmt::format("cannot open the {} audio decoder: {}", decoder->name, ffmpeg::error_string(r)));
+  }
+
+  // (Re)creates the resampler for the layout/format/rate of `f` (they may change mid-stream).
+  void ensure_resampler(const AVFrame& f) {
+    if (swr) return;
+    AVChannelLayout in_layout{};
+    if (f.ch_layout.order == AV_CHANNEL_ORDER_UNSPEC || f.ch_layout.nb_channels <= 0)
+      av_channel_layout_default(&in_layout, std::max(1, f.ch_layout.nb_channels));
+    else if (av_channel_layout_copy(&in_layout, &f.ch_layout) < 0)
+      fail("cannot read the audio channel layout");
+    AVChannelLayout out_layout{};
+    av_channel_layout_default(&out_layout, 2);
+    SwrContext* raw = nullptr;
+    const int r = swr_alloc_set_opts2(&raw, &out_layout, AV_SAMPLE_FMT_FLT, options.sample_rate, &in_layout,
+                                      static_cast<AVSampleFormat>(f.format), f.sample_rate, 0, nullptr);
+    av_channel_layout_uninit(&in_layout);
+    av_channel_layout_uninit(&out_layout);
+    swr.reset(raw);
+    if (r < 0 || swr_init(swr.get()) < 0) fail("cannot convert the audio to stereo float");
+  }
+
+  std::optional<AudioChunk> convert(const AVFrame& f) {
+    ensure_resampler(f);
+    const std::int64_t ts = f.best_effort_timestamp;
+    // Samples still inside the resampler belong before this frame.
+    const double buffered_s = static_cast<double>(swr_get_delay(swr.get(), options.sample_rate)) / options.sample_rate;
+    double pts;
+    if (ts != AV_NOPTS_VALUE)
+      pts = ts * av_q2d(stream->time_base) - options.origin_s - buffered_s;
+    else
+      pts = next_pts.value_or(0.0);
+    const int capacity = swr_get_out_samples(swr.get(), f.nb_samples);
+    if (capacity < 0) fail("cannot convert the audio");
+    AudioChunk chunk;
+    chunk.samples.resize(static_cast<std::size_t>(capacity) * 2);
+    auto* out = reinterpret_cast<std::uint8_t*>(chunk.samples.data());
+    const int converted =
+        swr_convert(swr.get(), &out, capacity, const_cast<const std::uint8_t**>(f.extended_data), f.nb_samples);
+    if (converted < 0) {
+      ++errors;
+      return std::nullopt;
+    }
+    chunk.samples.resize(static_cast<std::size_t>(converted) * 2);
+    chunk.pts_s = pts;
+    next_pts = pts + static_cast<double>(converted) / options.sample_rate;
+    if (cut_before) {
+      const double end = *next_pts;
+      if (end <= *cut_before) return AudioChunk{pts, {}};
+      if (pts < *cut_before) {
+        const auto skip = static_cast<std::size_t>(std::lround((*cut_before - pts) * options.sample_rate));
+        chunk.samples.erase(chunk.samples.begin(), chunk.samples.begin() + static_cast<std::ptrdiff_t>(std::min(
+                                                                               skip * 2, chunk.samples.size())));
+        chunk.pts_s = pts + static_cast<double>(skip) / options.sample_rate;
+      }
+      cut_before.reset();
+    }
+    return chunk;
+  }
+
+  std::optional<AudioChunk> next() {
+    while (!finished) {
+      const int received = avcodec_receive_frame(codec.get(), frame.get());
+      if (received == 0) {
+        consecutive_errors = 0;
+        if (frame->decode_error_flags != 0 || (frame->flags & AV_FRAME_FLAG_CORRUPT) != 0) ++errors;
+        auto chunk = convert(*frame);
+        av_frame_unref(frame.get());
+        if (chunk && !chunk->samples.empty()) return chunk;
+        continue;
+      }
+      if (received == AVERROR_EOF) {
+        finished = true;
+        break;
+      }
+      if (received != AVERROR(EAGAIN)) {
+        ++errors;
+        if (++consecutive_errors > 1000) fail("the audio decoder keeps failing");
+        continue;
+      }
+      if (draining) {
+        finished = true;
+        break;
+      }
+      const int read = av_read_frame(format.get(), packet.get());
+      if (read < 0) {
+        draining = true;
+        avcodec_send_packet(codec.get(), nullptr);
+        continue;
+      }
+      if (packet->stream_index == stream->index) {
+        const int sent = avcodec_send_packet(codec.get(), packet.get());
+        if (sent < 0 && sent != AVERROR(EAGAIN)) {
+          ++errors;  // a damaged packet: skip it, the next one may decode
+          if (++consecutive_errors > 1000) fail("the audio decoder keeps failing");
+        }
+      }
+      av_packet_unref(packet.get());
+    }
+    return std::nullopt;
+  }
+
+  void seek(double seconds) {
+    seconds = std::max(0.0, seconds);
+    const double target = seconds + options.origin_s;
+    const auto ts = static_cast<std::int64_t>(std::floor(target / av_q2d(stream->time_base)));
+    if (av_seek_frame(format.get(), stream->index, ts, AVSEEK_FLAG_BACKWARD) < 0)
+      fail(fmt::format("cannot seek the audio to {:.3f} s", seconds));
+    avcodec_flush_buffers(codec.get());
+    swr.reset();  // drops what it had buffered from before the seek
+    draining = finished = false;
+    consecutive_errors = 0;
+    next_pts.reset();
+    cut_before = seconds;
+  }
+};
+
+bool AudioSource::has_audio(const std::string& path, bool allow_network) {
+  try {
+    AudioSource source(path, AudioSourceOptions{48000, 0.0, allow_network});
+    return true;
+  } catch (const AudioError&) {
+    return false;
+  }
+}
+
+AudioSource::AudioSource(const std::string& path, AudioSourceOptions options) : impl_(std::make_unique<Impl>()) {
+  impl_->open(path, options);
+}
+AudioSource::~AudioSource() = default;
+AudioSource::AudioSource(AudioSource&&) noexcept = default;
+AudioSource& AudioSource::operator=(AudioSource&&) noexcept = default;
+
+std::optional<AudioChunk> AudioSource::next() { return impl_->next(); }
+void AudioSource::seek(double seconds) { impl_->seek(seconds); }
+int AudioSource::sample_rate() const { return impl_->options.sample_rate; }
+std::string AudioSource::codec_name() const { return impl_->codec->codec->name; }
+std::int64_t AudioSource::decode_errors() const { return impl_->errors; }
+
+}  // namespace nelf

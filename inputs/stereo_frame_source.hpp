@@ -1,0 +1,67 @@
+#pragma once
+// Stereo frames from a video input, split into the two views the way the layout says: a media file
+// in any layout (sbs, tab, fp, mono …, `alt` frame-sequential, `pair` = a second file for the right
+// view) or the built-in `synthetic:` clip. Shared by `nelf convert` (video) and `nelf play`, so that
+// both honour --layout, --right and --swap-eyes identically.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "inputs/stereo_layout.hpp"
+
+namespace nelf {
+
+// Both views of one stereo frame, as tightly packed RGBA of `bits` per channel (8: one byte per
+// channel; 16: native-endian uint16 per channel).
+struct StereoVideoFrame {
+  int width = 0, height = 0, bits = 8;
+  std::vector<std::uint8_t> left, right;
+  double aspect = 0.0;
+  double pts_s = 0.0;  // time from origin_s(): from 0 at the start (or the requested start)
+};
+
+inline std::size_t bytes_per_pixel(int bits) { return bits > 8 ? 8 : 4; }
+
+struct StereoSourceRequest {
+  std::string input;                   // a media file or `synthetic:[options]`
+  std::string right;                   // second input for layout pair
+  std::optional<StereoLayout> layout;  // nullopt: detect
+  bool swap_eyes = false;
+  std::optional<double> start_s;  // start here (seconds from the start of the input)
+  bool quiet = false;             // no line describing the input, no layout warning
+  bool allow_network = false;     // FFmpeg protocols beyond file and pipe
+};
+
+class StereoFrameSource {
+ public:
+  virtual ~StereoFrameSource() = default;
+  // The next frame, or nullopt at the end. Damaged data is skipped and counted (lost_frames());
+  // unrecoverable problems throw UserError.
+  virtual std::optional<StereoVideoFrame> next() = 0;
+  virtual double frame_rate() const = 0;
+  virtual std::optional<long> expected_frames() const = 0;
+  // Input duration in seconds from origin_s() when known.
+  virtual std::optional<double> duration_s() const = 0;
+  // Positions the source so that next() returns the frames at or after `seconds` (on the pts_s
+  // timeline, i.e. from origin_s()). Throws UserError when the input cannot seek.
+  virtual void seek(double seconds) = 0;
+  // The container whose audio/subtitles go with the video (opened separately), if any.
+  virtual std::string audio_path() const { return {}; }
+  virtual bool has_generated_audio() const { return false; }
+  // Mono samples [first, first + count) of generated audio, counted from pts_s 0.
+  virtual std::vector<float> generated_audio(std::int64_t /*first*/, int /*count*/) const { return {}; }
+  virtual int generated_audio_rate() const { return 0; }
+  // Frames lost or damaged so far (decode errors, read errors, frames promised but missing).
+  virtual std::int64_t lost_frames() const { return 0; }
+  // Source time (s, on the container's clock) that becomes pts_s 0.
+  virtual double origin_s() const { return 0.0; }
+};
+
+// Opens the input (and --right), detects the layout from the first frame and prints one line
+// describing it unless quiet. Throws UserError: status 1 for inputs that cannot be used, 2 for
+// options that contradict the input (same messages as `nelf convert`).
+std::unique_ptr<StereoFrameSource> open_stereo_frame_source(const StereoSourceRequest& request);
+
+}  // namespace nelf
