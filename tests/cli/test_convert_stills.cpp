@@ -67,23 +67,7 @@ AreaStats stats(const test::ReadBack& img, int x0, int y0, int x1, int y1) {
   return s;
 }
 
-// A light-field profile with a small panel (same physical size as the HMZ-T1's), so that the CPU
-// compositor finishes in milliseconds.
-std::filesystem::path small_profile(const TempDir& dir) {
-  const auto path = dir / "small.toml";
-  test::write_file(path, R"(name = "small"
-[display]
-resolution = [160, 90]
-pixel_pitch_mm = 0.096
-[lens_array]
-pitch_mm = 1.0
-focal_length_mm = 3.3
-[viewing]
-eye_relief_mm = 25.0
-virtual_image_mm = 1000.0
-)");
-  return path;
-}
+std::filesystem::path small_profile(const TempDir& dir) { return test::write_small_profile(dir); }
 
 std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
 

@@ -27,23 +27,7 @@ std::vector<std::string> files_in(const std::filesystem::path& dir) {
   return names;
 }
 
-// A light-field profile with a 160x90 panel so that llvmpipe composites in milliseconds. Its signal
-// is the HMZ-T1's (hdmi-fp-720p60): the panel sits centred in each 1280x720 eye area.
-std::filesystem::path small_profile(const TempDir& dir) {
-  const auto path = dir / "small.toml";
-  write_file(path, R"(name = "small"
-[display]
-resolution = [160, 90]
-pixel_pitch_mm = 0.096
-[lens_array]
-pitch_mm = 1.0
-focal_length_mm = 3.3
-[viewing]
-eye_relief_mm = 25.0
-virtual_image_mm = 1000.0
-)");
-  return path;
-}
+std::filesystem::path small_profile(const TempDir& dir) { return test::write_small_profile(dir); }
 
 const std::string h264 = " -c:v libx264 -preset ultrafast -pix_fmt yuv420p";
 

@@ -21,21 +21,7 @@ namespace {
 
 std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
 
-std::filesystem::path small_profile(const TempDir& dir) {
-  const auto path = dir / "small.toml";
-  write_file(path, R"(name = "small"
-[display]
-resolution = [160, 90]
-pixel_pitch_mm = 0.096
-[lens_array]
-pitch_mm = 1.0
-focal_length_mm = 3.3
-[viewing]
-eye_relief_mm = 25.0
-virtual_image_mm = 1000.0
-)");
-  return path;
-}
+std::filesystem::path small_profile(const TempDir& dir) { return test::write_small_profile(dir); }
 
 // Side by side at `fps` for `seconds`: left red-ish, right blue-ish, a moving white box, and a
 // 440 Hz tone unless `audio` is false.

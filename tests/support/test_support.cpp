@@ -70,4 +70,20 @@ CommandResult run_command(const std::string& command_line) {
   return r;
 }
 
+std::filesystem::path write_small_profile(const TempDir& dir) {
+  const auto path = dir / "small.toml";
+  write_file(path, R"(name = "small"
+[display]
+resolution = [160, 90]
+pixel_pitch_mm = 0.096
+[lens_array]
+pitch_mm = 1.0
+focal_length_mm = 3.3
+[viewing]
+eye_relief_mm = 25.0
+virtual_image_mm = 1000.0
+)");
+  return path;
+}
+
 }  // namespace nelf::test

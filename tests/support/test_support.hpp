@@ -40,4 +40,9 @@ inline CommandResult run_nelf(const std::string& args) { return run_command(std:
 // Quotes a string for /bin/sh.
 std::string shell_quote(const std::string& s);
 
+// Writes `dir`/small.toml and returns its path: a light-field profile with a 160x90 panel (the
+// HMZ-T1's physical size) so that llvmpipe and the CPU reference composite in milliseconds. Its
+// signal is the HMZ-T1's (hdmi-fp-720p60): the panel sits centred in each 1280x720 eye area.
+std::filesystem::path write_small_profile(const TempDir& dir);
+
 }  // namespace nelf::test

@@ -22,23 +22,7 @@
 namespace nelf {
 namespace {
 
-// A light-field profile with a 160x90 panel so that llvmpipe composites in milliseconds; its signal
-// is the HMZ-T1's, so the panel sits centred in each 1280x720 eye area of the 1280x1470 frame.
-Profile small_profile(const test::TempDir& dir) {
-  const auto path = dir / "small.toml";
-  test::write_file(path, R"(name = "small"
-[display]
-resolution = [160, 90]
-pixel_pitch_mm = 0.096
-[lens_array]
-pitch_mm = 1.0
-focal_length_mm = 3.3
-[viewing]
-eye_relief_mm = 25.0
-virtual_image_mm = 1000.0
-)");
-  return load_profile(path.string());
-}
+Profile small_profile(const test::TempDir& dir) { return load_profile(test::write_small_profile(dir).string()); }
 
 // 2 s at 30 fps, side by side: left view red-ish, right view blue-ish, each with a white box that
 // moves 5 px per frame (the frame number, visible).
