@@ -2,21 +2,19 @@
 
 #include <fmt/format.h>
 
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <memory>
 #include <optional>
 #include <thread>
 #include <utility>
 
 #include "app/commands.hpp"
+#include "app/interrupt.hpp"
+#include "app/live_display.hpp"
 #include "compositor/calibration_controls.hpp"
 #include "compositor/gl_compositor.hpp"
 #include "compositor/text_overlay.hpp"
-#include "hmz_output/kms_display.hpp"
 #include "hmz_output/packing.hpp"
-#include "hmz_output/window_display.hpp"
 
 namespace nelf::app {
 
@@ -29,53 +27,8 @@ constexpr auto kMessageTime = std::chrono::milliseconds(2500);
 constexpr auto kIdlePresent = std::chrono::milliseconds(100);
 constexpr auto kPoll = std::chrono::milliseconds(10);
 
-std::atomic<bool> interrupted{false};
-extern "C" void on_calibrate_interrupt(int) { interrupted.store(true); }
-
-// SIGINT/SIGTERM end the session cleanly (the profile is still saved) for its lifetime.
-class InterruptGuard {
- public:
-  InterruptGuard() {
-    interrupted.store(false);
-    struct sigaction action {};
-    action.sa_handler = on_calibrate_interrupt;
-    sigemptyset(&action.sa_mask);
-    sigaction(SIGINT, &action, &previous_int_);
-    sigaction(SIGTERM, &action, &previous_term_);
-  }
-  ~InterruptGuard() {
-    sigaction(SIGINT, &previous_int_, nullptr);
-    sigaction(SIGTERM, &previous_term_, nullptr);
-  }
-  InterruptGuard(const InterruptGuard&) = delete;
-  InterruptGuard& operator=(const InterruptGuard&) = delete;
-
- private:
-  struct sigaction previous_int_ {};
-  struct sigaction previous_term_ {};
-};
-
 std::unique_ptr<Display> open_display(const CalibrateSession& s) {
-  DisplayOptions options;
-  options.kind = s.output;
-  options.signal = s.signal;
-  const auto panel = s.profile.display.resolution;
-  options.packed = {s.signal.packed_width(panel[0]), s.signal.packed_height(panel[1])};
-  options.title = "nelf calibrate (h: help)";
-  options.monitor = s.monitor;
-  options.connector = s.connector;
-  if (s.output == OutputKind::kms) {
-    try {
-      return open_kms_display(options);
-    } catch (const KmsError& e) {
-      throw UserError(e.what(), 1);
-    }
-  }
-  try {
-    return open_window_display(options);
-  } catch (const std::exception& e) {
-    throw UserError(e.what(), 1);
-  }
+  return open_live_display({s.output, s.monitor, s.connector, "nelf calibrate (h: help)"}, s.profile, s.signal);
 }
 
 // The pattern's views on the GPU, rebuilt when the pattern or its geometry changes.

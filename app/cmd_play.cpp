@@ -8,10 +8,9 @@
 
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
+#include "app/live_display.hpp"
 #include "hmz_output/display.hpp"
-#include "hmz_output/kms_display.hpp"
 #include "hmz_output/player.hpp"
-#include "hmz_output/window_display.hpp"
 #include "inputs/stereo_frame_source.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/video_source.hpp"
@@ -27,27 +26,6 @@ struct PlayArgs : CommonArgs {
   bool quiet = false;
   std::string log_frames;
 };
-
-std::unique_ptr<Display> open_display(const DisplayOptions& options) {
-  switch (options.kind) {
-    case OutputKind::window:
-    case OutputKind::fullscreen:
-    case OutputKind::quad_buffer: {
-      try {
-        return open_window_display(options);
-      } catch (const std::exception& e) {
-        throw UserError(e.what(), 1);
-      }
-    }
-    case OutputKind::kms:
-      try {
-        return open_kms_display(options);
-      } catch (const std::exception& e) {
-        throw UserError(e.what(), 1);
-      }
-  }
-  throw UserError("unknown output", 2);
-}
 
 void run_play(const PlayArgs& args) {
   quiet_ffmpeg_logs(true);
@@ -81,15 +59,8 @@ void run_play(const PlayArgs& args) {
   options.log_frames = args.log_frames;
   options.quiet = args.quiet;
 
-  DisplayOptions display_options;
-  display_options.kind = kind;
-  display_options.signal = common.signal;
-  const auto panel = common.profile.display.resolution;
-  display_options.packed = {common.signal.packed_width(panel[0]), common.signal.packed_height(panel[1])};
-  display_options.monitor = args.monitor;
-  display_options.connector = args.connector;
-  display_options.title = fmt::format("nelf: {}", args.input);
-  const auto display = open_display(display_options);
+  const auto display = open_live_display({kind, args.monitor, args.connector, fmt::format("nelf: {}", args.input)},
+                                         common.profile, common.signal);
   if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", display->description());
 
   InterruptGuard guard;
