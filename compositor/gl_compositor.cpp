@@ -78,8 +78,10 @@ GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shar
   context_->make_current();
   empty_vertex_array_ = gl::make_vertex_array();
   sampler_ = gl::make_linear_clamp_sampler();
-  elemental_program_ = gl::make_program("fullscreen.vert", "elemental.frag");
-  border_program_ = gl::make_program("border_strips.vert", "elemental.frag", "#define NELF_AREA_SAMPLE 1\n");
+  const std::string subsamples = fmt::format("#define NELF_SUBSAMPLES {}\n", subsamples_per_axis(options_.fsaa));
+  elemental_program_ = gl::make_program("fullscreen.vert", "elemental.frag", subsamples);
+  border_program_ =
+      gl::make_program("border_strips.vert", "elemental.frag", subsamples + "#define NELF_AREA_SAMPLE 1\n");
   reduce_program_ = gl::make_program("fullscreen.vert", "prefilter_reduce.frag");
   box_program_ = gl::make_program("fullscreen.vert", "prefilter_box.frag");
   for (GLuint program : {elemental_program_.id(), border_program_.id(), reduce_program_.id(), box_program_.id()})
@@ -182,7 +184,6 @@ void GlCompositor::render_eye(Eye eye, const GlTextureView& view, const GlTarget
     set_uniform(p, "u_shift", f(m.shift_px.x), f(m.shift_px.y));
     set_uniform(p, "u_rotation", f(m.rotation_cos), f(m.rotation_sin));
     set_uniform_int(p, "u_has_lens_array", m.has_lens_array ? 1 : 0);
-    set_uniform_int(p, "u_subsamples", subsamples);
     if (m.has_lens_array) {
       set_uniform(p, "u_to_lens_plane", f(m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm)));
       set_uniform(p, "u_lattice_offset", f(m.lattice_offset_mm.x), f(m.lattice_offset_mm.y));

@@ -29,7 +29,12 @@ uniform float u_chief_ray_scale;  // (d_r - d_e) / d_l
 uniform vec2 u_screen_centre;     // mm
 uniform vec2 u_screen_size;       // mm
 uniform vec2 u_view_size;         // mm, stock devices
-uniform int u_subsamples;         // per axis: 1, 2 or 4
+// Sub-samples per axis (1, 2 or 4): a compile-time constant, so the loops below unroll (llvmpipe
+// runs a loop bounded by a uniform with per-lane masks, which cost ~as much as the taps).
+#ifndef NELF_SUBSAMPLES
+#define NELF_SUBSAMPLES 1
+#endif
+const int u_subsamples = NELF_SUBSAMPLES;
 
 out vec4 colour;
 
