@@ -59,12 +59,15 @@ class InterruptGuard {
   struct sigaction previous_term_ {};
 };
 
-// Both views of one stereo frame, as tightly packed RGBA of `bits` per channel.
+// Both views of one stereo frame, as tightly packed RGBA of `bits` per channel: width×height
+// pixels, or, when `block` is more than 1×1, the means of block[0]×block[1] pixels (the
+// compositor's prefilter block, done while converting from YUV).
 struct StereoVideoFrame {
   int width = 0, height = 0, bits = 8;
   std::vector<std::uint8_t> left, right;
   double aspect = 0.0;
   double pts_s = 0.0;  // output time, from 0
+  std::array<int, 2> block{1, 1};
 };
 
 std::size_t bytes_per_pixel(int bits) { return bits > 8 ? 8 : 4; }
@@ -119,7 +122,8 @@ class SyntheticFrameSource final : public StereoFrameSource {
                        to_rgba8(pair.left.image),
                        to_rgba8(pair.right.image),
                        pair.left.aspect(),
-                       static_cast<double>(next_ - first_) / clip_.settings().fps};
+                       static_cast<double>(next_ - first_) / clip_.settings().fps,
+                       {1, 1}};
     ++next_;
     return f;
   }
@@ -180,6 +184,7 @@ class FileFrameSource final : public StereoFrameSource {
         throw UserError(fmt::format("{}: {}", r.input, e.what()), 1);
       }
     }
+    reduce_while_converting(r);
     if (!r.quiet)
       fmt::print(stderr, "nelf: {}: {}x{} {}, layout {}{} ({})\n", r.input, source_.info().width, source_.info().height,
                  source_.info().video_codec, to_string(decision_.layout), decision_.swap_eyes ? " swapped" : "",
@@ -201,8 +206,14 @@ class FileFrameSource final : public StereoFrameSource {
       out.width = frame->width;
       out.height = frame->height;
       out.aspect = frame->display_aspect;
-      out.left = copy_region(*frame, whole);
-      out.right = copy_region(*other, whole);
+      if (reduced()) {
+        out.left = std::move(frame->reduced.at(0));
+        out.right = std::move(other->reduced.at(0));
+        out.block = block_;
+      } else {
+        out.left = copy_region(*frame, whole);
+        out.right = copy_region(*other, whole);
+      }
       if (decision_.swap_eyes) std::swap(out.left, out.right);
     } else {
       if (frame->width != width() || frame->height != height())
@@ -212,8 +223,14 @@ class FileFrameSource final : public StereoFrameSource {
       out.width = regions_.left.width;
       out.height = regions_.left.height;
       out.aspect = regions_.display_aspect;
-      out.left = copy_region(*frame, regions_.left);
-      out.right = copy_region(*frame, regions_.right);
+      if (reduced()) {
+        out.left = std::move(frame->reduced.at(0));
+        out.right = std::move(frame->reduced.at(1));
+        out.block = block_;
+      } else {
+        out.left = copy_region(*frame, regions_.left);
+        out.right = copy_region(*frame, regions_.right);
+      }
     }
     return out;
   }
@@ -261,6 +278,27 @@ class FileFrameSource final : public StereoFrameSource {
   }
   int width() const { return source_.info().width; }
   int height() const { return source_.info().height; }
+  bool reduced() const { return block_[0] > 1 || block_[1] > 1; }
+
+  // The compositor's first prefilter pass (a block mean over the view) done by swscale while it
+  // converts the decoded YUV: the GL stage then uploads and reads 1/block² of the texels. Only
+  // when both eyes want the same block, and the stream allows it (VideoSource::reduce_regions);
+  // otherwise whole RGBA frames as before. Pair inputs (two decoders) always take whole frames.
+  void reduce_while_converting(const VideoConvertRequest& r) {
+    if (decision_.layout == StereoLayout::pair) return;
+    const bool whole = decision_.layout == StereoLayout::alt;
+    const PixelRect left = whole ? PixelRect{0, 0, pending_->width, pending_->height} : regions_.left;
+    const PixelRect right = whole ? left : regions_.right;
+    const double aspect = whole ? pending_->display_aspect : regions_.display_aspect;
+    const auto block = prefilter_block(r.profile, r.compositor, Eye::left, left.width, left.height, aspect);
+    if (block != prefilter_block(r.profile, r.compositor, Eye::right, left.width, left.height, aspect)) return;
+    if (block[0] == 1 && block[1] == 1) return;
+    std::vector<ReducedRegion> wanted{{left.x, left.y, left.width, left.height, block[0], block[1]}};
+    if (!whole) wanted.push_back({right.x, right.y, right.width, right.height, block[0], block[1]});
+    if (!source_.reduce_regions(std::move(wanted))) return;
+    block_ = block;
+    pending_ = source_.convert_last();
+  }
 
   std::string path_;
   VideoSource source_;
@@ -269,6 +307,7 @@ class FileFrameSource final : public StereoFrameSource {
   LayoutDecision decision_;
   ViewRegions regions_;
   double origin_s_ = 0.0;
+  std::array<int, 2> block_{1, 1};
 };
 
 // Where packed frames go: an encoded file or an image sequence.
@@ -434,12 +473,13 @@ class ImageSequenceSink final : public FrameSink {
 // reads it back for the encoder.
 class PackedFrameRenderer {
  public:
-  PackedFrameRenderer(const VideoConvertRequest& r, int view_w, int view_h, int bits)
+  PackedFrameRenderer(const VideoConvertRequest& r, int view_w, int view_h, int bits, std::array<int, 2> block)
       : compositor_(r.profile, r.compositor, std::make_shared<gl::EglContext>(gl::ContextOptions{r.compositor.gpu})),
         signal_(r.signal),
         view_w_(view_w),
         view_h_(view_h),
-        bits_(bits) {
+        bits_(bits),
+        block_(block) {
     const auto panel = compositor_.panel();
     width_ = signal_.packed_width(panel[0]);
     height_ = signal_.packed_height(panel[1]);
@@ -455,7 +495,7 @@ class PackedFrameRenderer {
                                          area->y + (area->height - panel[1]) / 2};
     }
     const GLenum internal = bits > 8 ? GL_RGBA16 : GL_RGBA8;
-    for (auto& t : views_) t = gl::make_texture_2d(internal, view_w, view_h);
+    for (auto& t : views_) t = gl::make_texture_2d(internal, texture_w(), texture_h());
     packed_ = gl::make_texture_2d(internal, width_, height_);
     packed_fbo_ = gl::make_framebuffer(packed_);
   }
@@ -465,15 +505,19 @@ class PackedFrameRenderer {
   PackedFrame render(const StereoVideoFrame& f) {
     const GLenum type = bits_ > 8 ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage2D(views_[0].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, f.left.data());
-    glTextureSubImage2D(views_[1].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, f.right.data());
+    glTextureSubImage2D(views_[0].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, f.left.data());
+    glTextureSubImage2D(views_[1].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, f.right.data());
     const float black[4] = {0.f, 0.f, 0.f, 1.f};
     glClearNamedFramebufferfv(packed_fbo_.id(), GL_COLOR, 0, black);
     for (Eye eye : {Eye::left, Eye::right}) {
       const auto& origin = origins_[static_cast<int>(eye)];
       if (!origin) continue;
-      compositor_.render_eye(eye, GlTextureView{views_[static_cast<int>(eye)].id(), view_w_, view_h_, f.aspect},
-                             GlTarget{packed_fbo_.id(), origin->first, origin->second});
+      const GlTextureView view{views_[static_cast<int>(eye)].id(), view_w_, view_h_, f.aspect};
+      const GlTarget target{packed_fbo_.id(), origin->first, origin->second};
+      if (block_[0] > 1 || block_[1] > 1)
+        compositor_.render_eye_reduced(eye, GlReducedView{view, block_}, target);
+      else
+        compositor_.render_eye(eye, view, target);
     }
     PackedFrame out{width_, height_, bits_ > 8 ? 16 : 8,
                     std::vector<std::uint8_t>(static_cast<std::size_t>(width_) * height_ * bytes_per_pixel(bits_)),
@@ -486,9 +530,13 @@ class PackedFrameRenderer {
   }
 
  private:
+  int texture_w() const { return view_w_ / block_[0]; }
+  int texture_h() const { return view_h_ / block_[1]; }
+
   GlCompositor compositor_;
   Signal signal_;
   int view_w_, view_h_, bits_;
+  std::array<int, 2> block_;
   int width_ = 0, height_ = 0;
   std::array<std::optional<std::pair<int, int>>, 2> origins_;
   std::array<gl::Texture, 2> views_;
@@ -539,6 +587,7 @@ void convert_video(const VideoConvertRequest& r) {
   auto first = source->next();
   if (!first) throw UserError(fmt::format("{}: no frames to convert", r.input), 1);
   const int view_w = first->width, view_h = first->height, bits = first->bits;
+  const std::array<int, 2> block = first->block;
 
   std::optional<long> total = source->expected_frames();
   if (r.duration_s && total)
@@ -560,7 +609,7 @@ void convert_video(const VideoConvertRequest& r) {
       while (frame && !interrupted && !error.failed()) {
         if (r.max_frames && count >= *r.max_frames) break;
         if (r.duration_s && frame->pts_s >= *r.duration_s - 1e-9) break;
-        if (frame->width != view_w || frame->height != view_h || frame->bits != bits)
+        if (frame->width != view_w || frame->height != view_h || frame->bits != bits || frame->block != block)
           throw UserError(fmt::format("{}: the frame size changed mid-stream", r.input), 1);
         if (!decoded.push(std::move(*frame))) return;
         ++count;
@@ -576,7 +625,7 @@ void convert_video(const VideoConvertRequest& r) {
   // Composite thread: owns the GL context.
   std::jthread composite([&] {
     try {
-      PackedFrameRenderer renderer(r, view_w, view_h, bits);
+      PackedFrameRenderer renderer(r, view_w, view_h, bits, block);
       size_promise.set_value({renderer.width(), renderer.height()});
       while (auto frame = decoded.pop()) {
         if (interrupted || error.failed()) break;

@@ -70,6 +70,15 @@ PrefilterPlan plan_prefilter(const EyeMapping& mapping, int width, int height, i
   return plan;
 }
 
+std::array<int, 2> prefilter_block(const Profile& profile, const CompositorOptions& options, Eye eye, int width,
+                                   int height, double aspect) {
+  if (options.fsaa == 0) return {1, 1};
+  if (aspect <= 0.0) aspect = static_cast<double>(width) / height;
+  const PrefilterPlan plan =
+      plan_prefilter(make_eye_mapping(profile, eye, aspect), width, height, subsamples_per_axis(options.fsaa));
+  return plan.enabled ? plan.block : std::array<int, 2>{1, 1};
+}
+
 GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shared_ptr<gl::Context> context)
     : context_(context ? std::move(context) : std::make_shared<gl::EglContext>()),
       profile_(std::move(profile)),
@@ -98,7 +107,7 @@ GlCompositor::~GlCompositor() {
 }
 
 GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, int view_width, int view_height,
-                               PrefilterTargets& t) {
+                               bool reduced, PrefilterTargets& t) {
   // Intermediates keep the view's precision: 8-bit views (decoded 8-bit video) get RGBA8, which
   // llvmpipe filters on its fast fixed-point path; anything deeper gets RGBA16F.
   GLint view_format = 0;
@@ -112,7 +121,7 @@ GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, i
     fbo = gl::make_framebuffer(texture);
     size = wanted;
   };
-  const bool reduce = plan.block[0] > 1 || plan.block[1] > 1;
+  const bool reduce = !reduced && (plan.block[0] > 1 || plan.block[1] > 1);
   if (reduce) ensure(t.reduced, plan.reduced, t.reduced_texture, t.reduced_fbo);
   ensure(t.horizontal, {plan.output[0], plan.reduced[1]}, t.horizontal_texture, t.horizontal_fbo);
   ensure(t.output, plan.output, t.output_texture, t.output_fbo);
@@ -150,6 +159,14 @@ GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, i
 }
 
 void GlCompositor::render_eye(Eye eye, const GlTextureView& view, const GlTarget& target) {
+  render(eye, view, {1, 1}, target);
+}
+
+void GlCompositor::render_eye_reduced(Eye eye, const GlReducedView& view, const GlTarget& target) {
+  render(eye, view.view, view.block, target);
+}
+
+void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2> block, const GlTarget& target) {
   if (view.texture == 0 || view.width <= 0 || view.height <= 0)
     throw std::invalid_argument("GlCompositor::render_eye: no view texture");
   if (target.framebuffer == 0) throw std::invalid_argument("GlCompositor::render_eye: target framebuffer 0");
@@ -159,17 +176,23 @@ void GlCompositor::render_eye(Eye eye, const GlTextureView& view, const GlTarget
   GLuint source = view.texture;
   float scale[2] = {1.f, 1.f}, offset[2] = {0.f, 0.f};
   bool cut_outside = true;
-  if (options_.fsaa != 0) {
-    const PrefilterPlan plan = plan_prefilter(m, view.width, view.height, subsamples);
-    if (plan.enabled) {
-      source = prefilter(plan, view.texture, view.width, view.height, prefilter_targets_[static_cast<int>(eye)]);
-      for (int axis = 0; axis < 2; ++axis) {
-        // uv ∈ [0, 1] covers the samples between the margins.
-        scale[axis] = f(static_cast<double>(plan.output[axis] - 2 * plan.margin[axis]) / plan.output[axis]);
-        offset[axis] = f(static_cast<double>(plan.margin[axis]) / plan.output[axis]);
-      }
-      cut_outside = false;
+  const PrefilterPlan plan =
+      options_.fsaa != 0 ? plan_prefilter(m, view.width, view.height, subsamples) : PrefilterPlan{};
+  // block 1×1: the view itself (the prefilter averages it); else it must be the plan's block.
+  const bool reduced = block[0] > 1 || block[1] > 1;
+  const std::array<int, 2> wanted_block = plan.enabled ? plan.block : std::array<int, 2>{1, 1};
+  if (reduced && block != wanted_block)
+    throw std::invalid_argument(
+        fmt::format("GlCompositor::render_eye_reduced: the view is averaged in {}x{} blocks, the prefilter wants {}x{}",
+                    block[0], block[1], wanted_block[0], wanted_block[1]));
+  if (plan.enabled) {
+    source = prefilter(plan, view.texture, view.width, view.height, reduced, prefilter_targets_[static_cast<int>(eye)]);
+    for (int axis = 0; axis < 2; ++axis) {
+      // uv ∈ [0, 1] covers the samples between the margins.
+      scale[axis] = f(static_cast<double>(plan.output[axis] - 2 * plan.margin[axis]) / plan.output[axis]);
+      offset[axis] = f(static_cast<double>(plan.margin[axis]) / plan.output[axis]);
     }
+    cut_outside = false;
   }
 
   // Pass 1 (every pixel): point samples. Pass 2 (fsaa >= 1, lens arrays): strips along the
