@@ -91,9 +91,13 @@ GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shar
   elemental_program_ = gl::make_program("fullscreen.vert", "elemental.frag", subsamples);
   border_program_ =
       gl::make_program("border_strips.vert", "elemental.frag", subsamples + "#define NELF_AREA_SAMPLE 1\n");
+  map_program_ = gl::make_program("fullscreen.vert", "elemental.frag", subsamples + "#define NELF_COORDINATE_MAP 1\n");
+  lookup_program_ = gl::make_program("fullscreen.vert", "elemental_lookup.frag");
+  set_uniform_int(lookup_program_.id(), "u_map", 1);
   reduce_program_ = gl::make_program("fullscreen.vert", "prefilter_reduce.frag");
   box_program_ = gl::make_program("fullscreen.vert", "prefilter_box.frag");
-  for (GLuint program : {elemental_program_.id(), border_program_.id(), reduce_program_.id(), box_program_.id()})
+  for (GLuint program :
+       {elemental_program_.id(), border_program_.id(), reduce_program_.id(), box_program_.id(), lookup_program_.id()})
     set_uniform_int(program, program == box_program_.id() ? "u_input" : "u_view", 0);
   gl::check_error("creating the compositor's programs");
 }
@@ -197,7 +201,15 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
 
   // Pass 1 (every pixel): point samples. Pass 2 (fsaa >= 1, lens arrays): strips along the
   // elemental-image borders redo the pixels there with the per-lens area split.
-  for (const GLuint p : {elemental_program_.id(), border_program_.id()}) {
+  // One tap per pixel from the prefiltered view (fsaa 1): the pixel's coordinate comes from a map
+  // made once per eye and view geometry, so pass 1 only taps.
+  const int e = static_cast<int>(eye);
+  const bool use_map = plan.enabled && subsamples == 1;
+  const bool new_map =
+      use_map && (!coordinate_maps_[e].texture || coordinate_maps_[e].width != view.width ||
+                  coordinate_maps_[e].height != view.height || coordinate_maps_[e].aspect != view.aspect());
+  for (const GLuint p : {elemental_program_.id(), border_program_.id(), map_program_.id()}) {
+    if (p == map_program_.id() && !new_map) continue;
     set_uniform(p, "u_texture_scale", scale[0], scale[1]);
     set_uniform(p, "u_texture_offset", offset[0], offset[1]);
     set_uniform_int(p, "u_cut_outside", cut_outside ? 1 : 0);
@@ -220,12 +232,33 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
       set_uniform(p, "u_view_size", f(m.view_size_mm.x), f(m.view_size_mm.y));
     }
   }
+  glBindVertexArray(empty_vertex_array_.id());
+  CoordinateMap& map = coordinate_maps_[e];
+  if (new_map) {
+    map.fbo.reset();
+    map.texture = gl::make_texture_2d(GL_RG32F, m.panel[0], m.panel[1]);
+    map.fbo = gl::make_framebuffer(map.texture);
+    set_uniform(map_program_.id(), "u_region_origin", 0.f, 0.f);
+    glBindFramebuffer(GL_FRAMEBUFFER, map.fbo.id());
+    glViewport(0, 0, m.panel[0], m.panel[1]);
+    glUseProgram(map_program_.id());
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    map.width = view.width;
+    map.height = view.height;
+    map.aspect = view.aspect();
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   glViewport(target.x, target.y, m.panel[0], m.panel[1]);
-  glBindVertexArray(empty_vertex_array_.id());
   glBindSampler(0, sampler_.id());
   glBindTextureUnit(0, source);
-  glUseProgram(elemental_program_.id());
+  if (use_map) {
+    glBindSampler(1, 0);
+    glBindTextureUnit(1, map.texture.id());
+    set_uniform(lookup_program_.id(), "u_region_origin", f(target.x), f(target.y));
+    glUseProgram(lookup_program_.id());
+  } else {
+    glUseProgram(elemental_program_.id());
+  }
   glDrawArrays(GL_TRIANGLES, 0, 3);
   if (options_.fsaa != 0 && m.has_lens_array) {
     glUseProgram(border_program_.id());

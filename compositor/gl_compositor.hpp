@@ -112,6 +112,14 @@ class GlCompositor final : public Compositor {
     gl::Texture texture;
     gl::Framebuffer fbo;
   };
+  // Per eye: where pass 1 taps the prefiltered view for each pixel (elemental.frag's mapping,
+  // rendered once), for the view geometry it was made for.
+  struct CoordinateMap {
+    gl::Texture texture;
+    gl::Framebuffer fbo;
+    int width = 0, height = 0;
+    double aspect = 0.0;
+  };
   struct UploadedView {
     gl::Texture texture;
     int width = 0, height = 0;
@@ -128,7 +136,8 @@ class GlCompositor final : public Compositor {
   CompositorOptions options_;
   gl::VertexArray empty_vertex_array_;
   gl::Sampler sampler_;
-  gl::Program elemental_program_, border_program_, reduce_program_, box_program_;
+  gl::Program elemental_program_, border_program_, reduce_program_, box_program_, map_program_, lookup_program_;
+  std::array<CoordinateMap, 2> coordinate_maps_;       // per eye, fsaa 1
   std::array<PrefilterTargets, 2> prefilter_targets_;  // per eye
   std::array<UploadedView, 2> uploads_;                // per eye, for compose()
   std::array<EyeTarget, 2> eye_targets_;               // per eye, for compose()

@@ -186,5 +186,22 @@ TEST(GlCompositor, ReducedViewRendersLikeTheFullView) {
                std::invalid_argument);
 }
 
+// Pass 1 at fsaa 1 taps through a coordinate map made once per eye and view geometry: a view of
+// another size or aspect must get a new map (the same image as a fresh compositor draws).
+TEST(GlCompositor, CoordinateMapFollowsTheViewGeometry) {
+  const auto context = shared_gl_context();
+  const Profile profile = test::small_panel_profile();
+  const View wide{test::photo_chart(480, 270), 0.0}, squarer{test::photo_chart(480, 360), 0.0};
+  GlCompositor reused(profile, {1, std::nullopt}, shared_gl_context());
+  reused.compose({wide, wide});
+  const Image after_wide = reused.compose({squarer, squarer})[0];
+  const Image fresh = gl_eye(profile, 1, squarer);
+  EXPECT_GT(psnr(after_wide, fresh), 90.0) << "the first view's map was reused";
+  const View anamorphic{test::photo_chart(480, 360), 16.0 / 9.0};  // same size, other aspect
+  const Image after_aspect = reused.compose({anamorphic, anamorphic})[0];
+  EXPECT_GT(psnr(after_aspect, gl_eye(profile, 1, anamorphic)), 90.0) << "the map ignored the aspect";
+  EXPECT_LT(psnr(after_aspect, fresh), 60.0) << "the aspect should change the image";
+}
+
 }  // namespace
 }  // namespace nelf
