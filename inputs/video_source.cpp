@@ -39,6 +39,7 @@ std::string_view to_string(ColorMatrix matrix) {
 std::string_view to_string(ColorRange range) { return range == ColorRange::full ? "full" : "limited"; }
 
 const void* VideoFrame::pixels() const {
+  if (!reduced.empty()) return nullptr;
   return bits > 8 ? static_cast<const void*>(rgba16.data()) : static_cast<const void*>(rgba8.data());
 }
 
@@ -50,6 +51,7 @@ float VideoFrame::channel(int x, int y, int c) const {
 }
 
 Image VideoFrame::to_image() const {
+  if (!reduced.empty()) throw std::logic_error("VideoFrame::to_image: the frame was delivered as reduced regions");
   Image image(width, height);
   float* out = image.data();
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 4;

@@ -83,6 +83,7 @@ struct VideoFrame {
   // block_y pixels, 1 byte per channel (bits 8) or 2 (bits 16, native endian); rgba8/rgba16 empty.
   std::vector<std::vector<std::uint8_t>> reduced;
 
+  // Whole frames only (not after reduce_regions): pixels() is then null, to_image() throws.
   const void* pixels() const;
   // Channel c (0 = R … 3 = A) of pixel (x, y), normalised to 0..1.
   float channel(int x, int y, int c) const;
