@@ -38,16 +38,18 @@ class FrameQueue {
  public:
   explicit FrameQueue(std::size_t capacity) : capacity_(capacity) {}
 
-  // Decode thread: waits for room (or a seek, or stop). Returns the seek target if one is pending.
+  // Decode thread: waits for room (or a seek, a new reduction, or stop). Returns the seek target
+  // and the reduction if one is pending.
   struct Work {
     std::optional<double> seek_to;
+    std::optional<ViewBlockChooser> reduce;
     std::uint64_t generation = 0;
     bool stop = false;
   };
   Work wait_for_work() {
     std::unique_lock lock(mutex_);
-    changed_.wait(lock, [&] { return stop_ || seek_to_ || (!end_ && items_.size() < capacity_); });
-    Work work{std::exchange(seek_to_, std::nullopt), generation_, stop_};
+    changed_.wait(lock, [&] { return stop_ || seek_to_ || reduce_ || (!end_ && items_.size() < capacity_); });
+    Work work{std::exchange(seek_to_, std::nullopt), std::exchange(reduce_, std::nullopt), generation_, stop_};
     return work;
   }
   void push(StereoVideoFrame frame, std::uint64_t generation) {
@@ -75,6 +77,13 @@ class FrameQueue {
     ++generation_;
     items_.clear();
     end_ = false;
+    changed_.notify_all();
+  }
+  // The views of frames decoded from now on as `choose` says (StereoFrameSource::reduce_views);
+  // frames already queued keep theirs.
+  void reduce_views(ViewBlockChooser choose) {
+    std::lock_guard lock(mutex_);
+    reduce_ = std::move(choose);
     changed_.notify_all();
   }
   void stop() {
@@ -118,6 +127,7 @@ class FrameQueue {
   std::deque<StereoVideoFrame> items_;
   std::size_t capacity_;
   std::optional<double> seek_to_;
+  std::optional<ViewBlockChooser> reduce_;
   std::uint64_t generation_ = 0;
   bool end_ = false, stop_ = false;
   std::exception_ptr error_;
@@ -132,6 +142,7 @@ void decode_loop(StereoFrameSource& source, FrameQueue& queue) {
     for (;;) {
       const FrameQueue::Work work = queue.wait_for_work();
       if (work.stop) return;
+      if (work.reduce) source.reduce_views(*work.reduce);
       if (work.seek_to) {
         source.seek(*work.seek_to);
         continue;
@@ -269,14 +280,19 @@ class PackedRenderer {
   }
   const Profile& profile() const { return profile_; }
 
+  // The frame's views into the view textures: whole views, or (frame.block > 1×1) the block means
+  // the compositor's prefilter starts from, 1/block² of the texels to upload and composite.
   void upload(const StereoVideoFrame& frame, bool calibration) {
-    if (frame.width != view_w_ || frame.height != view_h_ || frame.bits != bits_) {
+    if (frame.width != view_w_ || frame.height != view_h_ || frame.bits != bits_ || frame.block != block_ ||
+        frame.aspect != aspect_) {
       view_w_ = frame.width;
       view_h_ = frame.height;
       bits_ = frame.bits;
-      for (auto& t : views_) t = gl::make_texture_2d(bits_ > 8 ? GL_RGBA16 : GL_RGBA8, view_w_, view_h_);
+      block_ = frame.block;
+      aspect_ = frame.aspect;
+      for (auto& t : views_) t = gl::make_texture_2d(bits_ > 8 ? GL_RGBA16 : GL_RGBA8, texture_w(), texture_h());
+      update_wanted_blocks();
     }
-    aspect_ = frame.aspect;
     const GLenum type = bits_ > 8 ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     for (int i = 0; i < 2; ++i) {
@@ -284,17 +300,22 @@ class PackedRenderer {
       if (calibration) {
         std::vector<std::uint8_t> copy = source;
         draw_over(copy, calibration_grid(i), bits_);
-        glTextureSubImage2D(views_[i].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, copy.data());
+        glTextureSubImage2D(views_[i].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, copy.data());
       } else {
-        glTextureSubImage2D(views_[i].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, source.data());
+        glTextureSubImage2D(views_[i].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, source.data());
       }
     }
     gl::check_error("uploading the views");
   }
 
-  // The grid for view `i` at the current view size and optics (made when first needed).
+  // The block each eye's prefilter wants for the current views and optics ({1, 1}: whole views).
+  std::array<int, 2> wanted_block(Eye eye) const { return wanted_blocks_[static_cast<int>(eye)]; }
+
+  // The grid for view `i` at the view texture's size and the current optics (made when first
+  // needed). On block means the grid is drawn at their size: the lines are then as thick as the
+  // compositor's prefilter would have made them anyway, and at full contrast.
   const Image& calibration_grid(int i) {
-    const PatternGeometry geometry = pattern_geometry(profile_, view_w_, view_h_);
+    const PatternGeometry geometry = pattern_geometry(profile_, texture_w(), texture_h());
     if (!grid_ || !(grid_geometry_ == geometry)) {
       grid_ = make_test_pattern(TestPattern::grid, geometry);
       grid_geometry_ = geometry;
@@ -316,15 +337,34 @@ class PackedRenderer {
       const auto& origin = origins_[static_cast<int>(eye)];
       if (!origin) continue;
       const int view = static_cast<int>(eye) ^ (swap_eyes ? 1 : 0);
-      const GlTextureView shown = overlay_.apply(eye, GlTextureView{views_[view].id(), view_w_, view_h_, aspect_});
-      compositor_->render_eye(eye, shown, GlTarget{fbo, origin->first, origin->second});
+      // The text goes onto the texture as it is (block means: at their size, where it is as sharp
+      // as the prefilter would leave full-size text, and its cap height still 1/20 of the view).
+      const GlTextureView shown =
+          overlay_.apply(eye, GlTextureView{views_[view].id(), texture_w(), texture_h(),
+                                            aspect_ > 0.0 ? aspect_ : double(view_w_) / view_h_});
+      const GlTarget target{fbo, origin->first, origin->second};
+      if (reduced() && block_ == wanted_block(eye))
+        compositor_->render_eye_reduced(eye, GlReducedView{{shown.texture, view_w_, view_h_, aspect_}, block_}, target);
+      else  // whole views, or block means made for optics changed since (a key): a smaller view
+        compositor_->render_eye(eye, shown, target);
     }
   }
 
  private:
+  bool reduced() const { return block_[0] > 1 || block_[1] > 1; }
+  int texture_w() const { return view_w_ / block_[0]; }
+  int texture_h() const { return view_h_ / block_[1]; }
+  void update_wanted_blocks() {
+    for (Eye eye : {Eye::left, Eye::right})
+      wanted_blocks_[static_cast<int>(eye)] =
+          view_w_ > 0 ? prefilter_block(profile_, options_.compositor, eye, view_w_, view_h_, aspect_)
+                      : std::array<int, 2>{1, 1};
+  }
+
   void rebuild() {
     compositor_.reset();
     compositor_ = std::make_unique<GlCompositor>(profile_, options_.compositor, display_.context());
+    update_wanted_blocks();
     const auto panel = compositor_->panel();
     const auto packed = display_.packed_size();
     for (Eye eye : {Eye::left, Eye::right}) {
@@ -354,6 +394,8 @@ class PackedRenderer {
   std::array<std::optional<std::pair<int, int>>, 2> origins_;
   std::array<gl::Texture, 2> views_;
   int view_w_ = 0, view_h_ = 0, bits_ = 8;
+  std::array<int, 2> block_{1, 1};  // of the views in the textures
+  std::array<std::array<int, 2>, 2> wanted_blocks_{};
   double aspect_ = 0.0;
 };
 
@@ -454,6 +496,14 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   const double refresh_period = 1.0 / display.refresh_hz();
   const double fps = source.frame_rate();
   FrameScheduler scheduler(refresh_period, fps > 0 ? 1.0 / fps : 0.0);
+  // Views as the prefilter's block means where the input allows (swscale makes them while
+  // converting from YUV): far less to convert, upload and composite per frame.
+  const auto blocks_for = [&options](const Profile& profile) -> ViewBlockChooser {
+    return [profile, compositor = options.compositor](int width, int height, double aspect) {
+      return stereo_prefilter_block(profile, compositor, width, height, aspect);
+    };
+  };
+  source.reduce_views(blocks_for(options.profile));
   FrameQueue queue(6);
   std::jthread decoder([&] { decode_loop(source, queue); });
   struct StopDecoder {
@@ -499,6 +549,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   auto change_profile = [&](Profile changed, const std::string& what) {
     try {
       renderer.set_profile(changed);
+      queue.reduce_views(blocks_for(changed));  // the block follows the optics
       dirty = true;
       say(what);
     } catch (const std::exception& e) {
