@@ -238,24 +238,52 @@ class AudioFeeder {
 
 // The calibration overlay: `nelf calibrate`'s grid pattern (lines 16 cells across, a yellow centre
 // cross, the eye's letter) drawn over the view, so that the eyes' alignment and the lens grid can
-// be judged on the movie itself. `pattern` is the grid as RGBA float at the view's size.
-void draw_over(std::vector<std::uint8_t>& pixels, const Image& pattern, int bits) {
-  const std::size_t n = static_cast<std::size_t>(pattern.width()) * pattern.height();
-  const float* p = pattern.data();
+// be judged on the movie itself. `cover` is the grid at the texture's size (cover_grid): where its
+// alpha is 1 the grid replaces the movie, where 0 the movie shows through.
+void draw_over(std::vector<std::uint8_t>& pixels, const Image& cover, int bits) {
+  const std::size_t n = static_cast<std::size_t>(cover.width()) * cover.height();
+  const float* p = cover.data();
   for (std::size_t i = 0; i < n; ++i) {
-    const float r = p[i * 4], g = p[i * 4 + 1], b = p[i * 4 + 2];
-    if (std::max({r, g, b}) < 0.02f) continue;  // black: the movie shows through
-    const float rgb[3] = {r, g, b};
-    for (int c = 0; c < 3; ++c) {
-      const float v = std::clamp(rgb[c], 0.f, 1.f);
+    const float a = p[i * 4 + 3];
+    if (a <= 0.f) continue;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const float grid = std::clamp(p[i * 4 + c], 0.f, 1.f);
       if (bits > 8) {
-        const auto u = static_cast<std::uint16_t>(std::lround(v * 65535.f));
-        std::memcpy(&pixels[i * 8 + static_cast<std::size_t>(c) * 2], &u, 2);
+        std::uint16_t u = 0;
+        std::memcpy(&u, &pixels[i * 8 + c * 2], 2);
+        u = static_cast<std::uint16_t>(std::lround((u / 65535.f * (1.f - a) + grid * a) * 65535.f));
+        std::memcpy(&pixels[i * 8 + c * 2], &u, 2);
       } else {
-        pixels[i * 4 + static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(std::lround(v * 255.f));
+        pixels[i * 4 + c] =
+            static_cast<std::uint8_t>(std::lround((pixels[i * 4 + c] / 255.f * (1.f - a) + grid * a) * 255.f));
       }
     }
   }
+}
+
+// The full-size grid `pattern` as drawn over block means of `block` pixels: per block, alpha = the
+// share of its pixels the grid covers (not black), colour = their mean. Blending that over the
+// block mean of the movie gives exactly the block mean of the grid drawn over the full view, so
+// the lines look as they do without the reduction (at 1×1: the grid as is, alpha 0 or 1).
+Image cover_grid(const Image& pattern, std::array<int, 2> block) {
+  Image out(pattern.width() / block[0], pattern.height() / block[1]);
+  const float per_block = 1.f / static_cast<float>(block[0] * block[1]);
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x) {
+      Rgba sum{0.f, 0.f, 0.f, 0.f};
+      for (int by = 0; by < block[1]; ++by)
+        for (int bx = 0; bx < block[0]; ++bx) {
+          const Rgba& q = pattern.at(x * block[0] + bx, y * block[1] + by);
+          if (std::max({q.r, q.g, q.b}) < 0.02f) continue;  // black: the movie shows through
+          sum.r += q.r;
+          sum.g += q.g;
+          sum.b += q.b;
+          sum.a += 1.f;
+        }
+      Rgba& o = out.at(x, y);
+      o = sum.a > 0.f ? Rgba{sum.r / sum.a, sum.g / sum.a, sum.b / sum.a, sum.a * per_block} : Rgba{0.f, 0.f, 0.f, 0.f};
+    }
+  return out;
 }
 
 // The GL side: view textures, the compositor (rebuilt when the optics change) and the eye areas.
@@ -311,16 +339,17 @@ class PackedRenderer {
   // The block each eye's prefilter wants for the current views and optics ({1, 1}: whole views).
   std::array<int, 2> wanted_block(Eye eye) const { return wanted_blocks_[static_cast<int>(eye)]; }
 
-  // The grid for view `i` at the view texture's size and the current optics (made when first
-  // needed). On block means the grid is drawn at their size: the lines are then as thick as the
-  // compositor's prefilter would have made them anyway, and at full contrast.
+  // The grid for view `i` at the view's size and the current optics, as cover for the view
+  // texture (cover_grid: block means of it on reduced views). Made when first needed.
   const Image& calibration_grid(int i) {
-    const PatternGeometry geometry = pattern_geometry(profile_, texture_w(), texture_h());
-    if (!grid_ || !(grid_geometry_ == geometry)) {
-      grid_ = make_test_pattern(TestPattern::grid, geometry);
+    const PatternGeometry geometry = pattern_geometry(profile_, view_w_, view_h_);
+    if (!grid_ || !(grid_geometry_ == geometry) || grid_block_ != block_) {
+      const StereoPair pair = make_test_pattern(TestPattern::grid, geometry);
+      grid_ = {cover_grid(pair.left.image, block_), cover_grid(pair.right.image, block_)};
       grid_geometry_ = geometry;
+      grid_block_ = block_;
     }
-    return i == 0 ? grid_->left.image : grid_->right.image;
+    return (*grid_)[static_cast<std::size_t>(i)];
   }
 
   // The on-screen message ("" for none), blended into both views before compositing so that it
@@ -389,8 +418,9 @@ class PackedRenderer {
   Profile profile_;
   std::unique_ptr<GlCompositor> compositor_;
   TextOverlay overlay_;
-  std::optional<StereoPair> grid_;
+  std::optional<std::array<Image, 2>> grid_;
   PatternGeometry grid_geometry_;
+  std::array<int, 2> grid_block_{1, 1};
   std::array<std::optional<std::pair<int, int>>, 2> origins_;
   std::array<gl::Texture, 2> views_;
   int view_w_ = 0, view_h_ = 0, bits_ = 8;
