@@ -193,16 +193,45 @@ class ImageSequenceSink final : public FrameSink {
   bool finished_ = false;
 };
 
+// Packed-frame buffers go back to the GL stage once encoded. A fresh 7.5 MB vector per frame,
+// allocated on one thread and freed on another, came back from the kernel every time: zero-filled
+// pages and a page fault each, ~10% of the CPU time of a conversion.
+class BufferPool {
+ public:
+  std::vector<std::uint8_t> take(std::size_t size) {
+    std::vector<std::uint8_t> buffer;
+    {
+      std::lock_guard lock(mutex_);
+      if (!free_.empty()) {
+        buffer = std::move(free_.back());
+        free_.pop_back();
+      }
+    }
+    buffer.resize(size);
+    return buffer;
+  }
+  void give(std::vector<std::uint8_t> buffer) {
+    std::lock_guard lock(mutex_);
+    if (free_.size() < kKept) free_.push_back(std::move(buffer));
+  }
+
+ private:
+  static constexpr std::size_t kKept = 8;  // more than the queue between the stages holds
+  std::mutex mutex_;
+  std::vector<std::vector<std::uint8_t>> free_;
+};
+
 // The GL stage: uploads each frame's views, renders both eyes straight into the packed frame and
 // reads it back for the encoder.
 class PackedFrameRenderer {
  public:
-  PackedFrameRenderer(const VideoConvertRequest& r, int view_w, int view_h, int bits)
+  PackedFrameRenderer(const VideoConvertRequest& r, int view_w, int view_h, int bits, std::array<int, 2> block)
       : compositor_(r.profile, r.compositor, std::make_shared<gl::EglContext>(gl::ContextOptions{r.compositor.gpu})),
         signal_(r.signal),
         view_w_(view_w),
         view_h_(view_h),
-        bits_(bits) {
+        bits_(bits),
+        block_(block) {
     const auto panel = compositor_.panel();
     width_ = signal_.packed_width(panel[0]);
     height_ = signal_.packed_height(panel[1]);
@@ -218,29 +247,32 @@ class PackedFrameRenderer {
                                          area->y + (area->height - panel[1]) / 2};
     }
     const GLenum internal = bits > 8 ? GL_RGBA16 : GL_RGBA8;
-    for (auto& t : views_) t = gl::make_texture_2d(internal, view_w, view_h);
+    for (auto& t : views_) t = gl::make_texture_2d(internal, texture_w(), texture_h());
     packed_ = gl::make_texture_2d(internal, width_, height_);
     packed_fbo_ = gl::make_framebuffer(packed_);
   }
   int width() const { return width_; }
   int height() const { return height_; }
 
-  PackedFrame render(const StereoVideoFrame& f) {
+  PackedFrame render(const StereoVideoFrame& f, BufferPool& buffers) {
     const GLenum type = bits_ > 8 ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage2D(views_[0].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, f.left.data());
-    glTextureSubImage2D(views_[1].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, f.right.data());
+    glTextureSubImage2D(views_[0].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, f.left.data());
+    glTextureSubImage2D(views_[1].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, f.right.data());
     const float black[4] = {0.f, 0.f, 0.f, 1.f};
     glClearNamedFramebufferfv(packed_fbo_.id(), GL_COLOR, 0, black);
     for (Eye eye : {Eye::left, Eye::right}) {
       const auto& origin = origins_[static_cast<int>(eye)];
       if (!origin) continue;
-      compositor_.render_eye(eye, GlTextureView{views_[static_cast<int>(eye)].id(), view_w_, view_h_, f.aspect},
-                             GlTarget{packed_fbo_.id(), origin->first, origin->second});
+      const GlTextureView view{views_[static_cast<int>(eye)].id(), view_w_, view_h_, f.aspect};
+      const GlTarget target{packed_fbo_.id(), origin->first, origin->second};
+      if (block_[0] > 1 || block_[1] > 1)
+        compositor_.render_eye_reduced(eye, GlReducedView{view, block_}, target);
+      else
+        compositor_.render_eye(eye, view, target);
     }
     PackedFrame out{width_, height_, bits_ > 8 ? 16 : 8,
-                    std::vector<std::uint8_t>(static_cast<std::size_t>(width_) * height_ * bytes_per_pixel(bits_)),
-                    f.pts_s};
+                    buffers.take(static_cast<std::size_t>(width_) * height_ * bytes_per_pixel(bits_)), f.pts_s};
     glBindFramebuffer(GL_READ_FRAMEBUFFER, packed_fbo_.id());
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, width_, height_, GL_RGBA, type, out.rgba.data());
@@ -249,9 +281,13 @@ class PackedFrameRenderer {
   }
 
  private:
+  int texture_w() const { return view_w_ / block_[0]; }
+  int texture_h() const { return view_h_ / block_[1]; }
+
   GlCompositor compositor_;
   Signal signal_;
   int view_w_, view_h_, bits_;
+  std::array<int, 2> block_;
   int width_ = 0, height_ = 0;
   std::array<std::optional<std::pair<int, int>>, 2> origins_;
   std::array<gl::Texture, 2> views_;
@@ -287,13 +323,18 @@ bool is_image_sequence_pattern(const std::string& output) {
 
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
+  // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
   std::unique_ptr<StereoFrameSource> source = open_stereo_frame_source(
-      StereoSourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network});
+      StereoSourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network,
+                          [&r](int width, int height, double aspect) {
+                            return stereo_prefilter_block(r.profile, r.compositor, width, height, aspect);
+                          }});
 
   // The first frame fixes the view size and depth for the whole run.
   auto first = source->next();
   if (!first) throw UserError(fmt::format("{}: no frames to convert", r.input), 1);
   const int view_w = first->width, view_h = first->height, bits = first->bits;
+  const std::array<int, 2> block = first->block;
 
   std::optional<long> total = source->expected_frames();
   if (r.duration_s && total)
@@ -302,6 +343,7 @@ void convert_video(const VideoConvertRequest& r) {
 
   BoundedQueue<StereoVideoFrame> decoded(4);
   BoundedQueue<PackedFrame> packed(4);
+  BufferPool buffers;
   FirstError error;
   std::atomic<long> frames_written{0};
   std::promise<std::pair<int, int>> size_promise;
@@ -315,7 +357,7 @@ void convert_video(const VideoConvertRequest& r) {
       while (frame && !interrupted && !error.failed()) {
         if (r.max_frames && count >= *r.max_frames) break;
         if (r.duration_s && frame->pts_s >= *r.duration_s - 1e-9) break;
-        if (frame->width != view_w || frame->height != view_h || frame->bits != bits)
+        if (frame->width != view_w || frame->height != view_h || frame->bits != bits || frame->block != block)
           throw UserError(fmt::format("{}: the frame size changed mid-stream", r.input), 1);
         if (!decoded.push(std::move(*frame))) return;
         ++count;
@@ -331,11 +373,11 @@ void convert_video(const VideoConvertRequest& r) {
   // Composite thread: owns the GL context.
   std::jthread composite([&] {
     try {
-      PackedFrameRenderer renderer(r, view_w, view_h, bits);
+      PackedFrameRenderer renderer(r, view_w, view_h, bits, block);
       size_promise.set_value({renderer.width(), renderer.height()});
       while (auto frame = decoded.pop()) {
         if (interrupted || error.failed()) break;
-        if (!packed.push(renderer.render(*frame))) return;
+        if (!packed.push(renderer.render(*frame, buffers))) return;
       }
       packed.close();
     } catch (...) {
@@ -370,6 +412,7 @@ void convert_video(const VideoConvertRequest& r) {
     });
     while (auto frame = packed.pop()) {
       sink->write(*frame);
+      buffers.give(std::move(frame->rgba));
       ++frames_written;
       progress.frame_done();
     }

@@ -1,6 +1,7 @@
 // nelf: shows stereo content on near-eye light field displays. See README.md.
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 
 #include "app/commands.hpp"
@@ -17,6 +18,10 @@ constexpr nelf::app::CommandRegistrar registrars[] = {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A write past the file size limit (`ulimit -f`) would otherwise kill nelf with SIGXFSZ in the
+  // middle of a file, leaving it half-written; ignored, the write fails with EFBIG, which every sink
+  // reports in one line and cleans up after, as it does for a full disk (ENOSPC).
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"nelf: watch 3D movies and play stereo games on near-eye light field displays", "nelf"};
   app.set_version_flag("--version", fmt::format("nelf {}", NELF_VERSION));
   app.require_subcommand(1);

@@ -70,6 +70,22 @@ PrefilterPlan plan_prefilter(const EyeMapping& mapping, int width, int height, i
   return plan;
 }
 
+std::array<int, 2> stereo_prefilter_block(const Profile& profile, const CompositorOptions& options, int width,
+                                          int height, double aspect) {
+  const auto block = prefilter_block(profile, options, Eye::left, width, height, aspect);
+  if (block != prefilter_block(profile, options, Eye::right, width, height, aspect)) return {1, 1};
+  return block;
+}
+
+std::array<int, 2> prefilter_block(const Profile& profile, const CompositorOptions& options, Eye eye, int width,
+                                   int height, double aspect) {
+  if (options.fsaa == 0) return {1, 1};
+  if (aspect <= 0.0) aspect = static_cast<double>(width) / height;
+  const PrefilterPlan plan =
+      plan_prefilter(make_eye_mapping(profile, eye, aspect), width, height, subsamples_per_axis(options.fsaa));
+  return plan.enabled ? plan.block : std::array<int, 2>{1, 1};
+}
+
 GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shared_ptr<gl::Context> context)
     : context_(context ? std::move(context) : std::make_shared<gl::EglContext>()),
       profile_(std::move(profile)),
@@ -78,11 +94,17 @@ GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shar
   context_->make_current();
   empty_vertex_array_ = gl::make_vertex_array();
   sampler_ = gl::make_linear_clamp_sampler();
-  elemental_program_ = gl::make_program("fullscreen.vert", "elemental.frag");
-  border_program_ = gl::make_program("border_strips.vert", "elemental.frag", "#define NELF_AREA_SAMPLE 1\n");
+  const std::string subsamples = fmt::format("#define NELF_SUBSAMPLES {}\n", subsamples_per_axis(options_.fsaa));
+  elemental_program_ = gl::make_program("fullscreen.vert", "elemental.frag", subsamples);
+  border_program_ =
+      gl::make_program("border_strips.vert", "elemental.frag", subsamples + "#define NELF_AREA_SAMPLE 1\n");
+  map_program_ = gl::make_program("fullscreen.vert", "elemental.frag", subsamples + "#define NELF_COORDINATE_MAP 1\n");
+  lookup_program_ = gl::make_program("fullscreen.vert", "elemental_lookup.frag");
+  set_uniform_int(lookup_program_.id(), "u_map", 1);
   reduce_program_ = gl::make_program("fullscreen.vert", "prefilter_reduce.frag");
   box_program_ = gl::make_program("fullscreen.vert", "prefilter_box.frag");
-  for (GLuint program : {elemental_program_.id(), border_program_.id(), reduce_program_.id(), box_program_.id()})
+  for (GLuint program :
+       {elemental_program_.id(), border_program_.id(), reduce_program_.id(), box_program_.id(), lookup_program_.id()})
     set_uniform_int(program, program == box_program_.id() ? "u_input" : "u_view", 0);
   gl::check_error("creating the compositor's programs");
 }
@@ -96,7 +118,7 @@ GlCompositor::~GlCompositor() {
 }
 
 GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, int view_width, int view_height,
-                               PrefilterTargets& t) {
+                               bool reduced, PrefilterTargets& t) {
   // Intermediates keep the view's precision: 8-bit views (decoded 8-bit video) get RGBA8, which
   // llvmpipe filters on its fast fixed-point path; anything deeper gets RGBA16F.
   GLint view_format = 0;
@@ -110,7 +132,7 @@ GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, i
     fbo = gl::make_framebuffer(texture);
     size = wanted;
   };
-  const bool reduce = plan.block[0] > 1 || plan.block[1] > 1;
+  const bool reduce = !reduced && (plan.block[0] > 1 || plan.block[1] > 1);
   if (reduce) ensure(t.reduced, plan.reduced, t.reduced_texture, t.reduced_fbo);
   ensure(t.horizontal, {plan.output[0], plan.reduced[1]}, t.horizontal_texture, t.horizontal_fbo);
   ensure(t.output, plan.output, t.output_texture, t.output_fbo);
@@ -148,6 +170,14 @@ GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, i
 }
 
 void GlCompositor::render_eye(Eye eye, const GlTextureView& view, const GlTarget& target) {
+  render(eye, view, {1, 1}, target);
+}
+
+void GlCompositor::render_eye_reduced(Eye eye, const GlReducedView& view, const GlTarget& target) {
+  render(eye, view.view, view.block, target);
+}
+
+void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2> block, const GlTarget& target) {
   if (view.texture == 0 || view.width <= 0 || view.height <= 0)
     throw std::invalid_argument("GlCompositor::render_eye: no view texture");
   if (target.framebuffer == 0) throw std::invalid_argument("GlCompositor::render_eye: target framebuffer 0");
@@ -157,22 +187,36 @@ void GlCompositor::render_eye(Eye eye, const GlTextureView& view, const GlTarget
   GLuint source = view.texture;
   float scale[2] = {1.f, 1.f}, offset[2] = {0.f, 0.f};
   bool cut_outside = true;
-  if (options_.fsaa != 0) {
-    const PrefilterPlan plan = plan_prefilter(m, view.width, view.height, subsamples);
-    if (plan.enabled) {
-      source = prefilter(plan, view.texture, view.width, view.height, prefilter_targets_[static_cast<int>(eye)]);
-      for (int axis = 0; axis < 2; ++axis) {
-        // uv ∈ [0, 1] covers the samples between the margins.
-        scale[axis] = f(static_cast<double>(plan.output[axis] - 2 * plan.margin[axis]) / plan.output[axis]);
-        offset[axis] = f(static_cast<double>(plan.margin[axis]) / plan.output[axis]);
-      }
-      cut_outside = false;
+  const PrefilterPlan plan =
+      options_.fsaa != 0 ? plan_prefilter(m, view.width, view.height, subsamples) : PrefilterPlan{};
+  // block 1×1: the view itself (the prefilter averages it); else it must be the plan's block.
+  const bool reduced = block[0] > 1 || block[1] > 1;
+  const std::array<int, 2> wanted_block = plan.enabled ? plan.block : std::array<int, 2>{1, 1};
+  if (reduced && block != wanted_block)
+    throw std::invalid_argument(
+        fmt::format("GlCompositor::render_eye_reduced: the view is averaged in {}x{} blocks, the prefilter wants {}x{}",
+                    block[0], block[1], wanted_block[0], wanted_block[1]));
+  if (plan.enabled) {
+    source = prefilter(plan, view.texture, view.width, view.height, reduced, prefilter_targets_[static_cast<int>(eye)]);
+    for (int axis = 0; axis < 2; ++axis) {
+      // uv ∈ [0, 1] covers the samples between the margins.
+      scale[axis] = f(static_cast<double>(plan.output[axis] - 2 * plan.margin[axis]) / plan.output[axis]);
+      offset[axis] = f(static_cast<double>(plan.margin[axis]) / plan.output[axis]);
     }
+    cut_outside = false;
   }
 
   // Pass 1 (every pixel): point samples. Pass 2 (fsaa >= 1, lens arrays): strips along the
   // elemental-image borders redo the pixels there with the per-lens area split.
-  for (const GLuint p : {elemental_program_.id(), border_program_.id()}) {
+  // One tap per pixel from the prefiltered view (fsaa 1): the pixel's coordinate comes from a map
+  // made once per eye and view geometry, so pass 1 only taps.
+  const int e = static_cast<int>(eye);
+  const bool use_map = plan.enabled && subsamples == 1;
+  const bool new_map =
+      use_map && (!coordinate_maps_[e].texture || coordinate_maps_[e].width != view.width ||
+                  coordinate_maps_[e].height != view.height || coordinate_maps_[e].aspect != view.aspect());
+  for (const GLuint p : {elemental_program_.id(), border_program_.id(), map_program_.id()}) {
+    if (p == map_program_.id() && !new_map) continue;
     set_uniform(p, "u_texture_scale", scale[0], scale[1]);
     set_uniform(p, "u_texture_offset", offset[0], offset[1]);
     set_uniform_int(p, "u_cut_outside", cut_outside ? 1 : 0);
@@ -182,7 +226,6 @@ void GlCompositor::render_eye(Eye eye, const GlTextureView& view, const GlTarget
     set_uniform(p, "u_shift", f(m.shift_px.x), f(m.shift_px.y));
     set_uniform(p, "u_rotation", f(m.rotation_cos), f(m.rotation_sin));
     set_uniform_int(p, "u_has_lens_array", m.has_lens_array ? 1 : 0);
-    set_uniform_int(p, "u_subsamples", subsamples);
     if (m.has_lens_array) {
       set_uniform(p, "u_to_lens_plane", f(m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm)));
       set_uniform(p, "u_lattice_offset", f(m.lattice_offset_mm.x), f(m.lattice_offset_mm.y));
@@ -196,12 +239,33 @@ void GlCompositor::render_eye(Eye eye, const GlTextureView& view, const GlTarget
       set_uniform(p, "u_view_size", f(m.view_size_mm.x), f(m.view_size_mm.y));
     }
   }
+  glBindVertexArray(empty_vertex_array_.id());
+  CoordinateMap& map = coordinate_maps_[e];
+  if (new_map) {
+    map.fbo.reset();
+    map.texture = gl::make_texture_2d(GL_RG32F, m.panel[0], m.panel[1]);
+    map.fbo = gl::make_framebuffer(map.texture);
+    set_uniform(map_program_.id(), "u_region_origin", 0.f, 0.f);
+    glBindFramebuffer(GL_FRAMEBUFFER, map.fbo.id());
+    glViewport(0, 0, m.panel[0], m.panel[1]);
+    glUseProgram(map_program_.id());
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    map.width = view.width;
+    map.height = view.height;
+    map.aspect = view.aspect();
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   glViewport(target.x, target.y, m.panel[0], m.panel[1]);
-  glBindVertexArray(empty_vertex_array_.id());
   glBindSampler(0, sampler_.id());
   glBindTextureUnit(0, source);
-  glUseProgram(elemental_program_.id());
+  if (use_map) {
+    glBindSampler(1, 0);
+    glBindTextureUnit(1, map.texture.id());
+    set_uniform(lookup_program_.id(), "u_region_origin", f(target.x), f(target.y));
+    glUseProgram(lookup_program_.id());
+  } else {
+    glUseProgram(elemental_program_.id());
+  }
   glDrawArrays(GL_TRIANGLES, 0, 3);
   if (options_.fsaa != 0 && m.has_lens_array) {
     glUseProgram(border_program_.id());

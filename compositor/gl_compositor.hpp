@@ -39,6 +39,15 @@ struct GlTextureView {
   }
 };
 
+// A view whose texture already holds the prefilter's first pass: the mean of each
+// block[0]×block[1] group of texels of a view.width×view.height view (view.texture is
+// view.width / block[0] × view.height / block[1] texels). Video conversion gets it from swscale's
+// area filter while converting the decoded YUV, so no full-resolution RGBA frame is ever made.
+struct GlReducedView {
+  GlTextureView view;
+  std::array<int, 2> block{1, 1};
+};
+
 // Where an eye image goes: a panel-sized rectangle of `framebuffer` whose lowest-addressed corner
 // (row 0 = the eye image's top row) is at (x, y). framebuffer 0 is not allowed (headless).
 struct GlTarget {
@@ -62,6 +71,16 @@ struct PrefilterPlan {
 // The plan for a view of `width`×`height` texels under `mapping`, with `subsamples` per pixel axis.
 PrefilterPlan plan_prefilter(const EyeMapping& mapping, int width, int height, int subsamples);
 
+// The block the prefilter averages first for `eye` of `profile` and a `width`×`height` view shown at
+// `aspect` (0 = width / height): what a GlReducedView for it must hold. {1, 1} when the compositor
+// samples the view itself (fsaa 0, or a footprint of at most a texel).
+std::array<int, 2> prefilter_block(const Profile& profile, const CompositorOptions& options, Eye eye, int width,
+                                   int height, double aspect);
+// The block both eyes take (one reduction serves a stereo frame's two views), or {1, 1} when they
+// differ: what to ask a video source for before render_eye_reduced.
+std::array<int, 2> stereo_prefilter_block(const Profile& profile, const CompositorOptions& options, int width,
+                                          int height, double aspect);
+
 class GlCompositor final : public Compositor {
  public:
   // Renders with `context` (headless EGL, a window's or a KMS surface's), or with a new headless
@@ -78,6 +97,9 @@ class GlCompositor final : public Compositor {
   // Renders `eye` from `view` into `target` (panel-sized region). Prefilters the view first
   // (fsaa ≥ 1): call once per eye per frame. Leaves the target framebuffer bound.
   void render_eye(Eye eye, const GlTextureView& view, const GlTarget& target);
+  // render_eye from a view already block-averaged; `view.block` must be prefilter_block() of it
+  // (else std::invalid_argument).
+  void render_eye_reduced(Eye eye, const GlReducedView& view, const GlTarget& target);
 
   const gl::Context& context() const { return *context_; }
   const Profile& profile() const { return profile_; }
@@ -94,21 +116,32 @@ class GlCompositor final : public Compositor {
     gl::Texture texture;
     gl::Framebuffer fbo;
   };
+  // Per eye: where pass 1 taps the prefiltered view for each pixel (elemental.frag's mapping,
+  // rendered once), for the view geometry it was made for.
+  struct CoordinateMap {
+    gl::Texture texture;
+    gl::Framebuffer fbo;
+    int width = 0, height = 0;
+    double aspect = 0.0;
+  };
   struct UploadedView {
     gl::Texture texture;
     int width = 0, height = 0;
   };
 
-  // Runs the prefilter passes; returns the texture the elemental pass samples.
-  GLuint prefilter(const PrefilterPlan& plan, GLuint view_texture, int view_width, int view_height,
+  // Runs the prefilter passes; returns the texture the elemental pass samples. `reduced`: the
+  // texture already holds the block means (the first pass is skipped).
+  GLuint prefilter(const PrefilterPlan& plan, GLuint view_texture, int view_width, int view_height, bool reduced,
                    PrefilterTargets& targets);
+  void render(Eye eye, const GlTextureView& view, std::array<int, 2> block, const GlTarget& target);
 
   std::shared_ptr<gl::Context> context_;
   Profile profile_;
   CompositorOptions options_;
   gl::VertexArray empty_vertex_array_;
   gl::Sampler sampler_;
-  gl::Program elemental_program_, border_program_, reduce_program_, box_program_;
+  gl::Program elemental_program_, border_program_, reduce_program_, box_program_, map_program_, lookup_program_;
+  std::array<CoordinateMap, 2> coordinate_maps_;       // per eye, fsaa 1
   std::array<PrefilterTargets, 2> prefilter_targets_;  // per eye
   std::array<UploadedView, 2> uploads_;                // per eye, for compose()
   std::array<EyeTarget, 2> eye_targets_;               // per eye, for compose()

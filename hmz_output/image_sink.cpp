@@ -1,5 +1,6 @@
 #include "hmz_output/image_sink.hpp"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 #include <fcntl.h>
 #include <fmt/format.h>
@@ -154,6 +155,29 @@ void check_image_writable(const fs::path& path, const ImageWriteOptions& options
                                       std::strerror(errno)));
 }
 
+namespace {
+
+// Writes `bytes` over the file at `path` with every write checked: a full disk (ENOSPC) or a file
+// size limit (EFBIG) is an error, not a silently truncated file.
+void write_bytes(const fs::path& path, const std::vector<unsigned char>& bytes, const fs::path& shown) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+  if (fd < 0) throw ImageWriteError(fmt::format("cannot write {}: {}", shown.string(), std::strerror(errno)));
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int error = n < 0 ? errno : EIO;
+      ::close(fd);
+      throw ImageWriteError(fmt::format("cannot write {}: {}", shown.string(), std::strerror(error)));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::close(fd) != 0) throw ImageWriteError(fmt::format("cannot write {}: {}", shown.string(), std::strerror(errno)));
+}
+
+}  // namespace
+
 void write_image_file(const Image& image, const fs::path& path, const ImageWriteOptions& options) {
   check_image_writable(path, options);
   if (image.empty()) throw ImageWriteError(fmt::format("cannot write {}: empty image", path.string()));
@@ -174,6 +198,10 @@ void write_image_file(const Image& image, const fs::path& path, const ImageWrite
     if (!out)
       throw ImageWriteError(
           fmt::format("cannot write {}: no {} writer ({})", path.string(), oiio_format_name(format), OIIO::geterror()));
+    // OIIO's writers (PNG at least) ignore failed writes, so a full disk would leave a truncated
+    // image and no error: encode into memory where the writer can, and write the bytes here.
+    OIIO::Filesystem::IOVecOutput encoded;
+    const bool in_memory = out->supports("ioproxy") != 0 && out->set_ioproxy(&encoded);
     if (!out->open(temporary.string(), spec))
       throw ImageWriteError(fmt::format("cannot write {}: {}", path.string(), out->geterror()));
     // RGB out of the RGBA floats: a pixel stride of four floats skips alpha.
@@ -182,6 +210,7 @@ void write_image_file(const Image& image, const fs::path& path, const ImageWrite
         out->write_image(OIIO::TypeDesc::FLOAT, image.data(), pixel_stride, pixel_stride * image.width());
     const bool closed = out->close();
     if (!written || !closed) throw ImageWriteError(fmt::format("cannot write {}: {}", path.string(), out->geterror()));
+    if (in_memory) write_bytes(temporary, encoded.buffer(), path);
   });
 }
 

@@ -48,7 +48,8 @@ class SyntheticFrameSource final : public StereoFrameSource {
                        to_rgba8(pair.left.image),
                        to_rgba8(pair.right.image),
                        pair.left.aspect(),
-                       static_cast<double>(next_ - first_) / clip_.settings().fps};
+                       static_cast<double>(next_ - first_) / clip_.settings().fps,
+                       {1, 1}};
     ++next_;
     return f;
   }
@@ -85,6 +86,9 @@ class FileFrameSource final : public StereoFrameSource {
                       1);
     if (!pending_) throw UserError(fmt::format("{}: no video frame could be decoded", r.input), 1);
     origin_s_ = source_.info().start_time_s + r.start_s.value_or(0.0);
+    alt_width_ = pending_->width;
+    alt_height_ = pending_->height;
+    alt_aspect_ = pending_->display_aspect;
     LayoutEvidence evidence;
     evidence.flag = r.layout;
     evidence.metadata = source_.stereo_metadata();
@@ -116,6 +120,7 @@ class FileFrameSource final : public StereoFrameSource {
         throw UserError(fmt::format("{}: {}", r.input, e.what()), 1);
       }
     }
+    if (r.view_block) reduce_views(r.view_block);
     if (!r.quiet)
       fmt::print(stderr, "nelf: {}: {}x{} {}, layout {}{} ({})\n", r.input, source_.info().width, source_.info().height,
                  source_.info().video_codec, to_string(decision_.layout), decision_.swap_eyes ? " swapped" : "",
@@ -137,8 +142,16 @@ class FileFrameSource final : public StereoFrameSource {
       out.width = frame->width;
       out.height = frame->height;
       out.aspect = frame->display_aspect;
-      out.left = copy_region(*frame, whole);
-      out.right = copy_region(*other, whole);
+      if (frame->reduced.empty() != other->reduced.empty())
+        throw UserError(fmt::format("{}: the two views of a frame differ in size", path_), 1);
+      if (!frame->reduced.empty()) {
+        out.left = std::move(frame->reduced.at(0));
+        out.right = std::move(other->reduced.at(0));
+        out.block = block_;
+      } else {
+        out.left = copy_region(*frame, whole);
+        out.right = copy_region(*other, whole);
+      }
       if (decision_.swap_eyes) std::swap(out.left, out.right);
     } else {
       if (frame->width != width() || frame->height != height())
@@ -148,8 +161,14 @@ class FileFrameSource final : public StereoFrameSource {
       out.width = regions_.left.width;
       out.height = regions_.left.height;
       out.aspect = regions_.display_aspect;
-      out.left = copy_region(*frame, regions_.left);
-      out.right = copy_region(*frame, regions_.right);
+      if (!frame->reduced.empty()) {
+        out.left = std::move(frame->reduced.at(0));
+        out.right = std::move(frame->reduced.at(1));
+        out.block = block_;
+      } else {
+        out.left = copy_region(*frame, regions_.left);
+        out.right = copy_region(*frame, regions_.right);
+      }
     }
     return out;
   }
@@ -187,6 +206,34 @@ class FileFrameSource final : public StereoFrameSource {
       throw UserError(e.what(), 1);
     }
   }
+  // The compositor's first prefilter pass (a block mean over the view) done by swscale while it
+  // converts the decoded YUV: the GL stage then uploads and reads 1/block² of the texels, and the
+  // full-resolution RGBA frame is never made. VideoSource keeps the regions across seeks.
+  std::array<int, 2> reduce_views(const ViewBlockChooser& choose) override {
+    if (decision_.layout == StereoLayout::pair) return block_;  // two decoders: whole frames
+    const bool whole = decision_.layout == StereoLayout::alt;
+    const PixelRect left = whole ? PixelRect{0, 0, alt_width_, alt_height_} : regions_.left;
+    const PixelRect right = whole ? left : regions_.right;
+    const double aspect = whole ? alt_aspect_ : regions_.display_aspect;
+    std::array<int, 2> block{1, 1};
+    if (choose) block = choose(left.width, left.height, aspect);
+    std::vector<ReducedRegion> wanted;
+    if (block[0] > 1 || block[1] > 1) {
+      wanted.push_back({left.x, left.y, left.width, left.height, block[0], block[1]});
+      if (!whole) wanted.push_back({right.x, right.y, right.width, right.height, block[0], block[1]});
+    }
+    try {
+      if (!source_.reduce_regions(std::move(wanted))) {
+        block = {1, 1};
+        source_.reduce_regions({});  // whole frames always work
+      }
+      if (block != block_ && pending_) pending_ = source_.convert_last();
+    } catch (const VideoError& e) {
+      throw UserError(e.what(), 1);
+    }
+    block_ = block;
+    return block_;
+  }
   std::int64_t lost_frames() const override {
     return source_.stats().problems() + (right_ ? right_->stats().problems() : 0);
   }
@@ -216,7 +263,10 @@ class FileFrameSource final : public StereoFrameSource {
   std::optional<VideoFrame> pending_;
   LayoutDecision decision_;
   ViewRegions regions_;
+  int alt_width_ = 0, alt_height_ = 0;  // layout alt: each frame is a whole view of this size
+  double alt_aspect_ = 0.0;
   double origin_s_ = 0.0;
+  std::array<int, 2> block_{1, 1};  // what reduce_views() set
 };
 
 }  // namespace

@@ -3,7 +3,9 @@
 // in any layout (sbs, tab, fp, mono …, `alt` frame-sequential, `pair` = a second file for the right
 // view) or the built-in `synthetic:` clip. Shared by `nelf convert` (video) and `nelf play`, so that
 // both honour --layout, --right and --swap-eyes identically.
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -14,13 +16,22 @@
 namespace nelf {
 
 // Both views of one stereo frame, as tightly packed RGBA of `bits` per channel (8: one byte per
-// channel; 16: native-endian uint16 per channel).
+// channel; 16: native-endian uint16 per channel): width×height pixels, or, when `block` is more
+// than 1×1, (width / block[0])×(height / block[1]) means of block[0]×block[1] pixels each (made
+// while converting from YUV, see StereoFrameSource::reduce_views). width, height and aspect are
+// always those of the full view.
 struct StereoVideoFrame {
   int width = 0, height = 0, bits = 8;
   std::vector<std::uint8_t> left, right;
   double aspect = 0.0;
   double pts_s = 0.0;  // time from origin_s(): from 0 at the start (or the requested start)
+  std::array<int, 2> block{1, 1};
 };
+
+// Which block of pixels the caller wants averaged into each delivered pixel of a view of
+// `view_width`×`view_height` pixels shown at `aspect` ({1, 1}: whole views). The caller decides
+// (e.g. the compositor's prefilter_block for both eyes); the source only honours it.
+using ViewBlockChooser = std::function<std::array<int, 2>(int view_width, int view_height, double aspect)>;
 
 inline std::size_t bytes_per_pixel(int bits) { return bits > 8 ? 8 : 4; }
 
@@ -32,6 +43,7 @@ struct StereoSourceRequest {
   std::optional<double> start_s;  // start here (seconds from the start of the input)
   bool quiet = false;             // no line describing the input, no layout warning
   bool allow_network = false;     // FFmpeg protocols beyond file and pipe
+  ViewBlockChooser view_block;    // empty: whole views; else as reduce_views() from the first frame
 };
 
 class StereoFrameSource {
@@ -47,6 +59,12 @@ class StereoFrameSource {
   // Positions the source so that next() returns the frames at or after `seconds` (on the pts_s
   // timeline, i.e. from origin_s()). Throws UserError when the input cannot seek.
   virtual void seek(double seconds) = 0;
+  // From the next frame on (seeks included), deliver the views block-averaged as `choose` says for
+  // this input's view size, when the input allows it (one block for both views, a stream swscale
+  // can crop: see VideoSource::reduce_regions); otherwise, or with an empty `choose` or {1, 1},
+  // whole views. Returns the block the next frames carry. The synthetic source and pair inputs
+  // always deliver whole views.
+  virtual std::array<int, 2> reduce_views(const ViewBlockChooser& /*choose*/) { return {1, 1}; }
   // The container whose audio/subtitles go with the video (opened separately), if any.
   virtual std::string audio_path() const { return {}; }
   virtual bool has_generated_audio() const { return false; }

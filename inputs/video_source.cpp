@@ -39,6 +39,7 @@ std::string_view to_string(ColorMatrix matrix) {
 std::string_view to_string(ColorRange range) { return range == ColorRange::full ? "full" : "limited"; }
 
 const void* VideoFrame::pixels() const {
+  if (!reduced.empty()) return nullptr;
   return bits > 8 ? static_cast<const void*>(rgba16.data()) : static_cast<const void*>(rgba8.data());
 }
 
@@ -50,6 +51,7 @@ float VideoFrame::channel(int x, int y, int c) const {
 }
 
 Image VideoFrame::to_image() const {
+  if (!reduced.empty()) throw std::logic_error("VideoFrame::to_image: the frame was delivered as reduced regions");
   Image image(width, height);
   float* out = image.data();
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 4;
@@ -215,13 +217,19 @@ struct VideoSource::Impl {
   PacketPtr packet;
   FramePtr frame;
   FramePtr converted;
+  FramePtr last;  // a reference to the frame delivered last (convert_last)
   SwsContextPtr sws;
+  // reduce_regions(): the regions, and a converter for their size (one size for all of them).
+  std::vector<ReducedRegion> regions;
+  SwsContextPtr reduce_sws;
+  int reduce_format = -1, reduce_colorspace = -1, reduce_full_range = -1;
   // What `sws` was built for; a change mid-stream (resolution switch) rebuilds it.
   int sws_width = 0, sws_height = 0, sws_format = -1, sws_colorspace = -1, sws_full_range = -1;
   bool draining = false;
   bool finished = false;
   int consecutive_errors = 0;
   double last_pts_s = 0.0;
+  double last_pts_s_before = 0.0;  // last_pts_s before the last frame (convert_last converts it again)
   std::int64_t frames_out = 0;
   DecodeStats stats;
   std::optional<StereoMetadata> frame_stereo;
@@ -358,7 +366,8 @@ struct VideoSource::Impl {
     packet.reset(av_packet_alloc());
     frame.reset(av_frame_alloc());
     converted.reset(av_frame_alloc());
-    if (!packet || !frame || !converted) fail("out of memory");
+    last.reset(av_frame_alloc());
+    if (!packet || !frame || !converted || !last) fail("out of memory");
   }
 
   // Frames the container promised but that never arrived (a truncated file). With an index
@@ -375,7 +384,7 @@ struct VideoSource::Impl {
     }
   }
 
-  void prepare_converter(const AVFrame& decoded, AVPixelFormat& source_format, int& colorspace, bool& full_range) {
+  void colour_of(const AVFrame& decoded, AVPixelFormat& source_format, int& colorspace, bool& full_range) const {
     const auto decoded_format = static_cast<AVPixelFormat>(decoded.format);
     // The frame's own tag (H.264 VUI) wins; an untagged frame inherits the container's.
     const AVColorRange range =
@@ -387,7 +396,10 @@ struct VideoSource::Impl {
     ColorMatrix matrix = matrix_from_av(decoded.colorspace, tagged);
     if (!tagged) matrix = info.matrix_tagged ? info.matrix : default_matrix_for_height(decoded.height);
     colorspace = sws_colorspace_for(matrix);
+  }
 
+  void prepare_converter(const AVFrame& decoded, AVPixelFormat& source_format, int& colorspace, bool& full_range) {
+    colour_of(decoded, source_format, colorspace, full_range);
     if (sws && sws_width == decoded.width && sws_height == decoded.height && sws_format == source_format &&
         sws_colorspace == colorspace && sws_full_range == static_cast<int>(full_range))
       return;
@@ -416,10 +428,97 @@ struct VideoSource::Impl {
       fail(fmt::format("cannot allocate a {}x{} frame: {}", decoded.width, decoded.height, error_string(allocated)));
   }
 
+  // Whether `regions` can be cut from frames like `decoded` and area-averaged by swscale.
+  bool can_reduce(const AVFrame& decoded, const std::vector<ReducedRegion>& wanted) const {
+    if (info.rotation_degrees != 0 || wanted.empty()) return false;
+    const AVPixFmtDescriptor* desc = av_pix_fmt_desc_get(static_cast<AVPixelFormat>(decoded.format));
+    if (desc == nullptr || (desc->flags & (AV_PIX_FMT_FLAG_BITSTREAM | AV_PIX_FMT_FLAG_PAL | AV_PIX_FMT_FLAG_HWACCEL)))
+      return false;
+    for (const ReducedRegion& r : wanted) {
+      if (r.block_x < 1 || r.block_y < 1 || r.width <= 0 || r.height <= 0 || r.width % r.block_x != 0 ||
+          r.height % r.block_y != 0 || r.x < 0 || r.y < 0 || r.x + r.width > decoded.width ||
+          r.y + r.height > decoded.height)
+        return false;
+      if (r.width != wanted[0].width || r.height != wanted[0].height || r.block_x != wanted[0].block_x ||
+          r.block_y != wanted[0].block_y)
+        return false;
+      // Cropping moves the chroma planes by whole samples only.
+      if (r.x % (1 << desc->log2_chroma_w) != 0 || r.y % (1 << desc->log2_chroma_h) != 0) return false;
+    }
+    return true;
+  }
+
+  // Each region of `decoded`, cropped (pointers only) and area-averaged to RGBA in one swscale call.
+  void convert_regions(AVFrame& decoded, VideoFrame& out) {
+    AVPixelFormat source_format = AV_PIX_FMT_NONE;
+    int colorspace = 0;
+    bool full_range = false;
+    colour_of(decoded, source_format, colorspace, full_range);
+    const ReducedRegion& size = regions.front();
+    const int out_w = size.width / size.block_x, out_h = size.height / size.block_y;
+    const AVPixelFormat target = bits_of(source_format) > 8 ? AV_PIX_FMT_RGBA64 : AV_PIX_FMT_RGBA;
+    if (!reduce_sws || reduce_format != source_format || reduce_colorspace != colorspace ||
+        reduce_full_range != static_cast<int>(full_range)) {
+      // SWS_AREA at a whole-number ratio weighs the pixels of each block equally (the prefilter's
+      // block mean); full chroma resolution in and out, accurate rounding.
+      reduce_sws.reset(sws_getContext(size.width, size.height, source_format, out_w, out_h, target,
+                                      SWS_AREA | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INT | SWS_FULL_CHR_H_INP, nullptr,
+                                      nullptr, nullptr));
+      if (!reduce_sws)
+        fail(fmt::format("cannot convert pixel format {} to RGBA",
+                         av_get_pix_fmt_name(source_format) ? av_get_pix_fmt_name(source_format) : "unknown"));
+      const int* coefficients = sws_getCoefficients(colorspace);
+      sws_setColorspaceDetails(reduce_sws.get(), coefficients, full_range ? 1 : 0, coefficients, 1, 0, 1 << 16,
+                               1 << 16);
+      reduce_format = source_format;
+      reduce_colorspace = colorspace;
+      reduce_full_range = full_range ? 1 : 0;
+    }
+    const int bytes_per_pixel = target == AV_PIX_FMT_RGBA64 ? 8 : 4;
+    out.bits = bytes_per_pixel == 8 ? 16 : 8;
+    FramePtr crop(av_frame_alloc());
+    if (!crop) fail("out of memory");
+    for (const ReducedRegion& r : regions) {
+      if (r.x + r.width > decoded.width || r.y + r.height > decoded.height)
+        fail(fmt::format("the frame size changed mid-stream ({}x{})", decoded.width, decoded.height));
+      av_frame_unref(crop.get());
+      if (const int referenced = av_frame_ref(crop.get(), &decoded); referenced < 0)
+        fail(fmt::format("cannot reference a decoded frame: {}", error_string(referenced)));
+      crop->crop_left = static_cast<std::size_t>(r.x);
+      crop->crop_top = static_cast<std::size_t>(r.y);
+      crop->crop_right = static_cast<std::size_t>(decoded.width - r.x - r.width);
+      crop->crop_bottom = static_cast<std::size_t>(decoded.height - r.y - r.height);
+      if (const int cropped = av_frame_apply_cropping(crop.get(), AV_FRAME_CROP_UNALIGNED); cropped < 0)
+        fail(fmt::format("cannot cut a view out of a frame: {}", error_string(cropped)));
+      std::vector<std::uint8_t> pixels(static_cast<std::size_t>(out_w) * static_cast<std::size_t>(out_h) *
+                                       static_cast<std::size_t>(bytes_per_pixel));
+      std::uint8_t* planes[4] = {pixels.data(), nullptr, nullptr, nullptr};
+      const int strides[4] = {out_w * bytes_per_pixel, 0, 0, 0};
+      if (const int rows = sws_scale(reduce_sws.get(), crop->data, crop->linesize, 0, r.height, planes, strides);
+          rows != out_h)
+        fail(fmt::format("cannot convert a {}x{} view to RGBA: {}", r.width, r.height,
+                         rows < 0 ? error_string(rows) : std::string("incomplete output")));
+      out.reduced.push_back(std::move(pixels));
+    }
+  }
+
   VideoFrame convert(AVFrame& decoded) {
     if (decoded.width <= 0 || decoded.height <= 0 || decoded.width > kMaxVideoDimension ||
         decoded.height > kMaxVideoDimension)
       fail(fmt::format("absurd frame size {}x{} in the stream", decoded.width, decoded.height));
+    VideoFrame out;
+    if (!regions.empty()) {
+      convert_regions(decoded, out);
+      out.width = decoded.width;
+      out.height = decoded.height;
+    } else {
+      convert_whole(decoded, out);
+    }
+    finish_frame(decoded, out);
+    return out;
+  }
+
+  void convert_whole(AVFrame& decoded, VideoFrame& out) {
     AVPixelFormat source_format = AV_PIX_FMT_NONE;
     int colorspace = 0;
     bool full_range = false;
@@ -432,7 +531,6 @@ struct VideoSource::Impl {
       fail(fmt::format("cannot convert a {}x{} frame to RGBA: {}", decoded.width, decoded.height,
                        rows < 0 ? error_string(rows) : std::string("incomplete output")));
 
-    VideoFrame out;
     const int rotation = info.rotation_degrees;
     const bool quarter_turn = rotation == 90 || rotation == 270;
     out.width = quarter_turn ? decoded.height : decoded.width;
@@ -442,7 +540,12 @@ struct VideoSource::Impl {
       copy_rotated(converted->data[0], converted->linesize[0], decoded.width, decoded.height, rotation, out.rgba16);
     else
       copy_rotated(converted->data[0], converted->linesize[0], decoded.width, decoded.height, rotation, out.rgba8);
+  }
 
+  // Aspect, timestamp and side data of a converted frame.
+  void finish_frame(AVFrame& decoded, VideoFrame& out) {
+    const int rotation = info.rotation_degrees;
+    const bool quarter_turn = rotation == 90 || rotation == 270;
     AVRational sar = av_guess_sample_aspect_ratio(format.get(), stream, &decoded);
     if (sar.num <= 0 || sar.den <= 0) sar = AVRational{1, 1};
     const double coded_aspect = static_cast<double>(decoded.width) * av_q2d(sar) / decoded.height;
@@ -452,12 +555,12 @@ struct VideoSource::Impl {
       out.pts_s = static_cast<double>(decoded.best_effort_timestamp) * av_q2d(stream->time_base);
     else  // no timestamp at all: continue at the nominal rate
       out.pts_s = frames_out == 0 ? info.start_time_s : last_pts_s + (info.fps > 0.0 ? 1.0 / info.fps : 0.0);
+    last_pts_s_before = last_pts_s;
     last_pts_s = out.pts_s;
     out.key_frame = decoded.key_frame != 0;
     out.stereo = stereo_metadata_from_frame(decoded);
     if (out.stereo) frame_stereo = out.stereo;
     ++frames_out;
-    return out;
   }
 
   std::optional<VideoFrame> next_frame() {
@@ -469,7 +572,8 @@ struct VideoSource::Impl {
         ++stats.frames_decoded;
         if ((frame->flags & AV_FRAME_FLAG_CORRUPT) != 0 || frame->decode_error_flags != 0) ++stats.decode_errors;
         VideoFrame out = convert(*frame);
-        av_frame_unref(frame.get());
+        av_frame_unref(last.get());
+        av_frame_move_ref(last.get(), frame.get());
         return out;
       }
       if (received == AVERROR_EOF) {
@@ -528,6 +632,24 @@ std::optional<VideoFrame> VideoSource::next_frame() {
   }
 }
 const DecodeStats& VideoSource::stats() const { return impl_->stats; }
+
+bool VideoSource::reduce_regions(std::vector<ReducedRegion> regions) {
+  Impl& m = *impl_;
+  if (!regions.empty()) {
+    if (m.last->buf[0] == nullptr) return false;  // nothing decoded yet to check the format against
+    if (!m.can_reduce(*m.last, regions)) return false;
+  }
+  m.regions = std::move(regions);
+  return true;
+}
+
+std::optional<VideoFrame> VideoSource::convert_last() {
+  Impl& m = *impl_;
+  if (m.last->buf[0] == nullptr) return std::nullopt;
+  --m.frames_out;  // the same frame again: keep the timestamp continuation as it was
+  m.last_pts_s = m.last_pts_s_before;
+  return m.convert(*m.last);
+}
 
 void VideoSource::seek(double seconds) {
   Impl& m = *impl_;

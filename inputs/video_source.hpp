@@ -60,9 +60,15 @@ struct VideoInfo {
   std::optional<StereoMetadata> stream_stereo;  // container/stream stereo metadata (Matroska, st3d)
 };
 
+// A part of every frame to deliver averaged over blocks of pixels (VideoSource::reduce_regions).
+struct ReducedRegion {
+  int x = 0, y = 0, width = 0, height = 0;  // pixels of the frame; width, height: multiples of the block
+  int block_x = 1, block_y = 1;             // pixels averaged per output pixel, per axis
+};
+
 // One decoded frame, upright, RGBA, row 0 at the top. Exactly one of rgba8/rgba16 holds the pixels
 // (tightly packed, 4 channels), ready for glTexImage2D with GL_RGBA8/GL_UNSIGNED_BYTE or
-// GL_RGBA16/GL_UNSIGNED_SHORT.
+// GL_RGBA16/GL_UNSIGNED_SHORT; or, after VideoSource::reduce_regions, `reduced` holds the regions.
 struct VideoFrame {
   int width = 0;
   int height = 0;
@@ -73,7 +79,11 @@ struct VideoFrame {
   double display_aspect = 0.0;
   bool key_frame = false;
   std::optional<StereoMetadata> stereo;  // frame-packing SEI on this frame, if it carried one
+  // After reduce_regions(): one tightly packed RGBA image per region, width / block_x × height /
+  // block_y pixels, 1 byte per channel (bits 8) or 2 (bits 16, native endian); rgba8/rgba16 empty.
+  std::vector<std::vector<std::uint8_t>> reduced;
 
+  // Whole frames only (not after reduce_regions): pixels() is then null, to_image() throws.
   const void* pixels() const;
   // Channel c (0 = R … 3 = A) of pixel (x, y), normalised to 0..1.
   float channel(int x, int y, int c) const;
@@ -112,6 +122,17 @@ class VideoSource {
   std::optional<VideoFrame> next_frame();
 
   const DecodeStats& stats() const;
+
+  // From now on, deliver each frame as `regions`, each averaged over its blocks while converting
+  // from the decoded YUV (swscale's area filter, exact for whole blocks): the full-resolution RGBA
+  // frame is never made, which is most of the cost of a 1080p frame on a CPU. Returns false, and
+  // changes nothing, when the stream cannot be delivered so: rotation metadata, a region off the
+  // chroma grid or not a whole number of blocks, or a pixel format that cannot be cropped.
+  // An empty list returns to whole frames.
+  bool reduce_regions(std::vector<ReducedRegion> regions);
+  // The frame next_frame() returned last, converted again as now set (e.g. after reduce_regions).
+  // nullopt before the first frame.
+  std::optional<VideoFrame> convert_last();
 
   // Positions decoding so that the next frames are those at or after `seconds` (from the start of
   // the stream): seeks to the keyframe before it and decodes up to it. Throws VideoError when the

@@ -29,7 +29,12 @@ uniform float u_chief_ray_scale;  // (d_r - d_e) / d_l
 uniform vec2 u_screen_centre;     // mm
 uniform vec2 u_screen_size;       // mm
 uniform vec2 u_view_size;         // mm, stock devices
-uniform int u_subsamples;         // per axis: 1, 2 or 4
+// Sub-samples per axis (1, 2 or 4): a compile-time constant, so the loops below unroll (llvmpipe
+// runs a loop bounded by a uniform with per-lane masks, which cost ~as much as the taps).
+#ifndef NELF_SUBSAMPLES
+#define NELF_SUBSAMPLES 1
+#endif
+const int u_subsamples = NELF_SUBSAMPLES;
 
 out vec4 colour;
 
@@ -52,14 +57,21 @@ vec3 tap(vec2 uv) {
   return textureLod(u_view, uv * u_texture_scale + u_texture_offset, 0.0).rgb;
 }
 
-// The view at display position s as seen through lens (m, n): black outside the lit block or the screen.
-vec3 through_lens(vec2 s, ivec2 lens) {
-  if (any(lessThan(lens, u_first_lens)) || any(greaterThanEqual(lens, u_first_lens + u_lenses))) return vec3(0.0);
+// Whether lens (m, n) is lit; if so, `uv` is the screen coordinate seen from display position s
+// through it.
+bool lens_coordinate(vec2 s, ivec2 lens, out vec2 uv) {
+  uv = vec2(0.0);
+  if (any(lessThan(lens, u_first_lens)) || any(greaterThanEqual(lens, u_first_lens + u_lenses))) return false;
   const vec2 c = u_lattice_offset + rotate(vec2(lens) * u_lens_pitch, 1.0);
   const vec2 v = c + (s - c) * u_chief_ray_scale;  // chief ray back to the screen plane
-  const vec2 uv =
-      vec2((v.x - u_screen_centre.x) / u_screen_size.x + 0.5, 0.5 - (v.y - u_screen_centre.y) / u_screen_size.y);
-  return tap(uv);
+  uv = vec2((v.x - u_screen_centre.x) / u_screen_size.x + 0.5, 0.5 - (v.y - u_screen_centre.y) / u_screen_size.y);
+  return true;
+}
+
+// The view at display position s as seen through lens (m, n): black outside the lit block or the screen.
+vec3 through_lens(vec2 s, ivec2 lens) {
+  vec2 uv;
+  return lens_coordinate(s, lens, uv) ? tap(uv) : vec3(0.0);
 }
 
 // Position in the lens lattice (units of the lens pitch, rotated frame) of display position s.
@@ -116,6 +128,24 @@ vec3 area_sample(vec2 pixel, float aperture) {
   return sum;
 }
 
+#ifdef NELF_COORDINATE_MAP
+// The coordinate map (one sub-sample per pixel, prefiltered view): for each pixel, where pass 1
+// would tap u_view (RG), or -1 where the display is black (the prefiltered texture's clamped edge
+// is black). elemental_lookup.frag then only taps: the mapping above is the same every frame,
+// and on llvmpipe it cost more than the tap.
+void main() {
+  const vec2 s = display_position(floor(gl_FragCoord.xy - u_region_origin) + 0.5);
+  vec2 uv;
+  bool lit = true;
+  if (!u_has_lens_array) {
+    const vec2 r = rotate(s, -1.0);
+    uv = vec2(r.x / u_view_size.x + 0.5, 0.5 - r.y / u_view_size.y);
+  } else {
+    lit = lens_coordinate(s, ivec2(floor(lattice_position(s) + 0.5)), uv);
+  }
+  colour = lit ? vec4(uv * u_texture_scale + u_texture_offset, 0.0, 1.0) : vec4(-1.0, -1.0, 0.0, 1.0);
+}
+#else
 void main() {
   // Stratified sub-samples (1, 2×2 or 4×4). Pass 1 point-samples each; the border-strip pass
   // (border_strips.vert) area-samples each sub-aperture, splitting it between the lenses it overlaps.
@@ -134,3 +164,4 @@ void main() {
   }
   colour = vec4(sum * (step_ * step_), 1.0);
 }
+#endif

@@ -5,27 +5,35 @@
 # (GL, llvmpipe without a GPU), frame packing and read-back. Not run by ctest; results go to
 # docs/PERFORMANCE.md.
 #
-# usage: tests/bench/convert_vs_ffmpeg.sh [NELF] [SECONDS] [RUNS]
+# usage: tests/bench/convert_vs_ffmpeg.sh [NELF] [SECONDS] [RUNS] [LAYOUT]
 #   NELF     the nelf binary (default build/nelf)
 #   SECONDS  clip length at 24 fps (default 5)
 #   RUNS     runs of each command; the median is reported (default 3)
+#   LAYOUT   half: a 1920x1080 half side-by-side clip, each eye squeezed to 960x1080 (what "a 1080p
+#            side-by-side movie" is; the default); full: 3840x1080, each eye 1920x1080
 set -euo pipefail
 nelf=$(realpath "${1:-build/nelf}")
 seconds=${2:-5}
 runs=${3:-3}
+layout=${4:-half}
 export LP_NUM_THREADS=${LP_NUM_THREADS:-$(nproc)}
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export MESA_SHADER_CACHE_DIR=$work/shader-cache
-clip=$work/clip.sbs.mkv
+case $layout in
+  half) clip=$work/clip.hsbs.mkv eye=960x1080 frame=1920x1080 ;;  # "hsbs": detected from the name
+  full) clip=$work/clip.sbs.mkv eye=1920x1080 frame=3840x1080 ;;
+  *) echo "LAYOUT must be half or full" >&2; exit 2 ;;
+esac
 
-# 1080p full side-by-side (two 1920x1080 views in 3840x1080) H.264 with AAC audio.
+# Side-by-side H.264 with AAC audio: a 1920x1080 test pattern per eye (hue-shifted for the right),
+# scaled to the eye's size, the two side by side.
 ffmpeg -nostdin -hide_banner -loglevel error -y \
-  -f lavfi -i "testsrc2=s=1920x1080:r=24:d=$seconds" \
-  -f lavfi -i "testsrc2=s=1920x1080:r=24:d=$seconds,hue=h=180" \
+  -f lavfi -i "testsrc2=s=1920x1080:r=24:d=$seconds,scale=$eye" \
+  -f lavfi -i "testsrc2=s=1920x1080:r=24:d=$seconds,hue=h=180,scale=$eye" \
   -f lavfi -i "sine=frequency=440:sample_rate=48000:duration=$seconds" \
-  -filter_complex "[0][1]hstack[v]" -map "[v]" -map 2:a \
+  -filter_complex "[0][1]hstack,setsar=1[v]" -map "[v]" -map 2:a \
   -c:v libx264 -preset veryfast -crf 20 -pix_fmt yuv420p -c:a aac "$clip"
 
 nelf_cmd() { "$nelf" convert "$clip" "$work/nelf.mkv" --profile hmz-t1 --quiet -y; }
@@ -56,7 +64,8 @@ frames=$(ffprobe -v error -count_packets -select_streams v:0 -show_entries strea
 size=$(ffprobe -v error -select_streams v:0 -show_entries stream=width,height -of csv=s=x:p=0 "$work/nelf.mkv")
 n=$(median "${nelf_times[@]}")
 f=$(median "${ffmpeg_times[@]}")
-echo "clip: ${seconds} s, 3840x1080 sbs H.264 24 fps; output ${size}, ${frames} frames, libx264 medium crf 18"
+echo "clip: ${seconds} s, $frame $layout sbs H.264 24 fps; output ${size}, ${frames} frames, libx264 medium crf 18"
 printf 'nelf convert: %.2f s (%.1f fps)\n' "$n" "$(echo "$frames / $n" | bc -l)"
 printf 'ffmpeg      : %.2f s (%.1f fps)\n' "$f" "$(echo "$frames / $f" | bc -l)"
 printf 'ratio       : %.2fx (median of %d runs each)\n' "$(echo "$n / $f" | bc -l)" "$runs"
+echo "load average: $(cut -d' ' -f1-3 /proc/loadavg) (LP_NUM_THREADS=$LP_NUM_THREADS, $(nproc) cores)"

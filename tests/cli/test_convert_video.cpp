@@ -431,5 +431,51 @@ TEST(ConvertVideo, InterruptLeavesNothing) {
   EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"small.toml"}));
 }
 
+// SIGTERM (what `kill`, systemd and container runtimes send) stops a conversion the way Ctrl-C
+// does: status 130, one line, nothing left of the output, whether a video file or an image
+// sequence was being written.
+TEST(ConvertVideo, TerminateLeavesNothing) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  for (const std::string output : {"out.mkv", "frame_%04d.png"}) {
+    SCOPED_TRACE(output);
+    const auto r =
+        run_command(std::string(NELF_BINARY) + " convert synthetic:duration=30,size=320x180 " + q(dir / output) +
+                    " --profile " + q(profile) + " & pid=$!; sleep 2; ls -A " + q(dir.path()) +
+                    "; kill -TERM $pid; "
+                    "(sleep 30; kill -KILL $pid) 2>/dev/null & guard=$!; "
+                    "wait $pid; status=$?; kill $guard; echo status $status");
+    if (output == "out.mkv") {
+      EXPECT_NE(r.out.find(".out.nelf-"), std::string::npos) << "no temporary file while converting: " << r.out;
+    } else {
+      EXPECT_NE(r.out.find("frame_0001.png"), std::string::npos) << "no frame written before the signal: " << r.out;
+    }
+    EXPECT_NE(r.out.find("status 130\n"), std::string::npos) << r.out << r.err;
+    EXPECT_NE(r.err.find("nelf: interrupted: no output written\n"), std::string::npos) << r.err;
+    EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"small.toml"}));
+  }
+}
+
+// A full disk, made real with a file size limit: writes past `ulimit -f` fail with EFBIG exactly as
+// they fail with ENOSPC on a full file system (nelf ignores SIGXFSZ, which would otherwise kill it
+// mid-file). Both sinks: one line naming the file and the cause, status 1, nothing left behind —
+// no temporary file and no truncated image.
+TEST(ConvertVideo, DiskFullLeavesNothing) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  for (const std::string output : {"out.mkv", "frame_%04d.png"}) {
+    SCOPED_TRACE(output);
+    // 64 blocks: 32 KiB under dash (512-byte blocks), 64 KiB under bash; a frame is more than that.
+    const auto r =
+        run_command("ulimit -f 64; " + std::string(NELF_BINARY) + " convert synthetic:duration=1,size=320x180 " +
+                    q(dir / output) + " --quiet --codec ffv1 --profile " + q(profile));
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(r.err.rfind("nelf: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("File too large"), std::string::npos) << r.err;
+    EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"small.toml"}));
+  }
+}
+
 }  // namespace
 }  // namespace nelf::test

@@ -142,5 +142,66 @@ TEST(GlVsReference, EightBitViewTextureThroughRenderEye) {
   }
 }
 
+const float* texel(const Image& image, int x, int y) {
+  return image.data() + (static_cast<std::size_t>(y) * image.width() + x) * 4;
+}
+
+// The prefilter's first pass (block mean) done by the caller (video conversion does it in
+// swscale): render_eye_reduced from the block means draws what render_eye draws from the view.
+TEST(GlCompositor, ReducedViewRendersLikeTheFullView) {
+  const auto context = shared_gl_context();
+  const Profile profile = test::small_panel_profile();
+  const CompositorOptions options{1, std::nullopt};
+  const Image chart = test::photo_chart(480, 272);
+  const std::array<int, 2> block = prefilter_block(profile, options, Eye::left, 480, 272, 0.0);
+  ASSERT_TRUE(block[0] > 1 || block[1] > 1) << "the test panel must prefilter in blocks";
+  ASSERT_EQ(480 % block[0], 0);
+  ASSERT_EQ(272 % block[1], 0);
+  // The block means, rounded to 8 bits as the reduce pass's RGBA8 target would hold them.
+  Image means(480 / block[0], 272 / block[1]);
+  for (int y = 0; y < means.height(); ++y)
+    for (int x = 0; x < means.width(); ++x)
+      for (int c = 0; c < 4; ++c) {
+        double sum = 0.0;
+        for (int j = 0; j < block[1]; ++j)
+          for (int i = 0; i < block[0]; ++i) sum += texel(chart, x * block[0] + i, y * block[1] + j)[c];
+        means.data()[(static_cast<std::size_t>(y) * means.width() + x) * 4 + c] =
+            static_cast<float>(std::round(sum / (block[0] * block[1]) * 255.0) / 255.0);
+      }
+  const gl::Texture full = upload_texture(chart, GL_RGBA8);
+  const gl::Texture reduced = upload_texture(means, GL_RGBA8);
+  const gl::Texture target = gl::make_texture_2d(GL_RGBA8, 320, 180);
+  const gl::Framebuffer fbo = gl::make_framebuffer(target);
+  GlCompositor compositor(profile, options, shared_gl_context());
+  compositor.render_eye(Eye::left, {full.id(), 480, 272, 0.0}, {fbo.id(), 0, 0});
+  const Image from_view = read_back(fbo.id(), 0, 0, 320, 180);
+  compositor.render_eye_reduced(Eye::left, {{reduced.id(), 480, 272, 0.0}, block}, {fbo.id(), 0, 0});
+  const Image from_means = read_back(fbo.id(), 0, 0, 320, 180);
+  const double db = psnr(from_means, from_view);
+  std::printf("render_eye_reduced against render_eye: %.2f dB\n", db);
+  EXPECT_GE(db, 45.0);
+  // A view averaged in other blocks than the prefilter's is refused, not drawn wrongly.
+  EXPECT_THROW(compositor.render_eye_reduced(Eye::left, {{reduced.id(), 480, 272, 0.0}, {block[0] * 2, block[1]}},
+                                             {fbo.id(), 0, 0}),
+               std::invalid_argument);
+}
+
+// Pass 1 at fsaa 1 taps through a coordinate map made once per eye and view geometry: a view of
+// another size or aspect must get a new map (the same image as a fresh compositor draws).
+TEST(GlCompositor, CoordinateMapFollowsTheViewGeometry) {
+  const auto context = shared_gl_context();
+  const Profile profile = test::small_panel_profile();
+  const View wide{test::photo_chart(480, 270), 0.0}, squarer{test::photo_chart(480, 360), 0.0};
+  GlCompositor reused(profile, {1, std::nullopt}, shared_gl_context());
+  reused.compose({wide, wide});
+  const Image after_wide = reused.compose({squarer, squarer})[0];
+  const Image fresh = gl_eye(profile, 1, squarer);
+  EXPECT_GT(psnr(after_wide, fresh), 90.0) << "the first view's map was reused";
+  const View anamorphic{test::photo_chart(480, 360), 16.0 / 9.0};  // same size, other aspect
+  const Image after_aspect = reused.compose({anamorphic, anamorphic})[0];
+  EXPECT_GT(psnr(after_aspect, gl_eye(profile, 1, anamorphic)), 90.0) << "the map ignored the aspect";
+  EXPECT_LT(psnr(after_aspect, fresh), 60.0) << "the aspect should change the image";
+}
+
 }  // namespace
 }  // namespace nelf

@@ -372,5 +372,79 @@ TEST_F(VideoSourceTest, NetworkProtocolsNeedPermission) {
   EXPECT_NE(error.find("--allow-network"), std::string::npos) << error;
 }
 
+// Mean over `block` of the whole frame's RGBA8 pixels at region origin (x0, y0).
+double block_mean(const VideoFrame& frame, int x0, int y0, int bx, int by, int c) {
+  double sum = 0.0;
+  for (int j = 0; j < by; ++j)
+    for (int i = 0; i < bx; ++i)
+      sum += frame.rgba8[(static_cast<std::size_t>(y0 + j) * static_cast<std::size_t>(frame.width) +
+                          static_cast<std::size_t>(x0 + i)) *
+                             4 +
+                         static_cast<std::size_t>(c)];
+  return sum / (bx * by);
+}
+
+// reduce_regions: each view cut from the decoded YUV and area-averaged by swscale equals the block
+// means of the whole-frame RGBA conversion (up to rounding and, for 4:2:0, chroma reconstruction),
+// left and right in their own images. The content stays inside the RGB gamut: swscale averages
+// before converting, so a pixel whose YUV lies outside the gamut counts unclipped (testsrc2's
+// saturated edges at this size go down to B = -78; rare in real video).
+TEST_F(VideoSourceTest, ReducedRegionsAreTheBlockMeansOfEachView) {
+  for (const std::string pix_fmt : {"yuv444p", "yuv420p"}) {
+    SCOPED_TRACE(pix_fmt);
+    const auto path = make_media(dir / ("sbs_" + pix_fmt + ".mkv"),
+                                 "-f lavfi -i testsrc2=s=128x72:r=10 -frames:v 2 -vf "
+                                 "lutrgb=r=val*0.6+50:g=val*0.6+50:b=val*0.6+50 -c:v libx264 -qp 0 -pix_fmt " +
+                                     pix_fmt);
+    VideoSource source(path.string());
+    const VideoFrame whole = *source.next_frame();
+    ASSERT_TRUE(whole.reduced.empty());
+    const std::vector<ReducedRegion> regions{{0, 0, 64, 72, 4, 2}, {64, 0, 64, 72, 4, 2}};
+    ASSERT_TRUE(source.reduce_regions(regions));
+    const VideoFrame again = *source.convert_last();
+    EXPECT_DOUBLE_EQ(again.pts_s, whole.pts_s);
+    ASSERT_EQ(again.reduced.size(), 2u);
+    double total = 0.0, worst = 0.0;
+    for (int r = 0; r < 2; ++r) {
+      ASSERT_EQ(again.reduced[r].size(), 16u * 36u * 4u);
+      for (int y = 0; y < 36; ++y)
+        for (int x = 0; x < 16; ++x)
+          for (int c = 0; c < 4; ++c) {
+            const double expected = block_mean(whole, regions[r].x + x * 4, y * 2, 4, 2, c);
+            const double got = again.reduced[r][(static_cast<std::size_t>(y) * 16 + x) * 4 + c];
+            total += std::abs(got - expected);
+            worst = std::max(worst, std::abs(got - expected));
+          }
+    }
+    const double mean = total / (2 * 16 * 36 * 4);
+    std::printf("%s: reduced vs block means of the RGBA frame: mean |diff| %.3f, max %.0f (8-bit codes)\n",
+                pix_fmt.c_str(), mean, worst);
+    EXPECT_LT(mean, pix_fmt == "yuv444p" ? 0.25 : 1.5);
+    EXPECT_LE(worst, pix_fmt == "yuv444p" ? 1.5 : 16.0);  // 4:2:0: chroma reconstructed differently at edges
+    // The next frame comes reduced too.
+    const VideoFrame next = *source.next_frame();
+    EXPECT_EQ(next.reduced.size(), 2u);
+    EXPECT_TRUE(next.rgba8.empty());
+  }
+}
+
+TEST_F(VideoSourceTest, ReduceRegionsRefusesWhatItCannotCut) {
+  const auto path =
+      make_media(dir / "420.mkv", "-f lavfi -i testsrc2=s=128x72:r=10 -frames:v 1 -c:v libx264 -pix_fmt yuv420p");
+  VideoSource source(path.string());
+  EXPECT_FALSE(source.reduce_regions({{0, 0, 64, 72, 4, 4}})) << "before the first frame";
+  ASSERT_TRUE(source.next_frame());
+  EXPECT_FALSE(source.reduce_regions({{1, 0, 64, 72, 4, 4}})) << "off the 4:2:0 chroma grid";
+  EXPECT_FALSE(source.reduce_regions({{0, 0, 62, 72, 4, 4}})) << "not whole blocks";
+  EXPECT_FALSE(source.reduce_regions({{96, 0, 64, 72, 4, 4}})) << "outside the frame";
+  const auto rotated =
+      make_media(dir / "rotated.mp4", "-i " + test::shell_quote(path.string()) + " -c copy -metadata:s:v:0 rotate=90");
+  VideoSource turned(rotated.string());
+  ASSERT_TRUE(turned.next_frame());
+  EXPECT_FALSE(turned.reduce_regions({{0, 0, 72, 64, 4, 4}})) << "rotated streams come whole";
+  // Refused: frames still come whole.
+  EXPECT_FALSE(turned.convert_last()->rgba8.empty());
+}
+
 }  // namespace
 }  // namespace nelf

@@ -94,8 +94,8 @@ TEST_F(PlayerWindowTest, PlaysTheClipInThePackedLayoutWithEachEyesContentAndFram
                     std::vector<float>(l.data(), l.data() + static_cast<std::size_t>(l.width()) * l.height() * 4)});
   };
 
-  auto source =
-      open_stereo_frame_source(StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
+  auto source = open_stereo_frame_source(
+      StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
   const PlayResult result = play(*display, *source, options);
   EXPECT_EQ(result.end, PlayEnd::end_of_file);
   ASSERT_GE(seen.size(), 5u) << "too few frames rendered";
@@ -138,7 +138,7 @@ TEST_F(PlayerWindowTest, SwapEyesPutsTheFirstStoredViewOnTheRight) {
   };
   std::atomic<bool> stop{false};
   auto source = open_stereo_frame_source(
-      StereoSourceRequest{clip.string(), "", StereoLayout::sbs, true, std::nullopt, true, false});
+      StereoSourceRequest{clip.string(), "", StereoLayout::sbs, true, std::nullopt, true, false, {}});
   // Stop after a few frames: this test is about the routing only.
   auto original = options.after_render;
   options.after_render = [&](const Display& d, double pts) {
@@ -167,8 +167,8 @@ TEST_F(PlayerWindowTest, ClosingTheWindowEndsPlaybackCleanly) {
   options.after_render = [&](const Display&, double) {
     if (++rendered == 3) glfwSetWindowShouldClose(glfwGetCurrentContext(), GLFW_TRUE);
   };
-  auto source =
-      open_stereo_frame_source(StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
+  auto source = open_stereo_frame_source(
+      StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
   const PlayResult result = play(*display, *source, options);
   EXPECT_EQ(result.end, PlayEnd::window_closed);
   EXPECT_EQ(result.counters.shown, 3);

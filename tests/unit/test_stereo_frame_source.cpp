@@ -1,0 +1,147 @@
+// StereoFrameSource: views delivered as block means when the caller asks (reduce_views), across
+// seeks and changes of the block.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "inputs/stereo_frame_source.hpp"
+#include "inputs/video_source.hpp"
+#include "support/media.hpp"
+#include "support/test_support.hpp"
+
+namespace nelf {
+namespace {
+
+using test::make_media;
+using test::TempDir;
+
+class StereoFrameSourceTest : public ::testing::Test {
+ protected:
+  void SetUp() override { quiet_ffmpeg_logs(true); }
+  TempDir dir;
+};
+
+// Mean of channel c over a tightly packed RGBA8 view.
+double channel_mean(const std::vector<std::uint8_t>& rgba, int c) {
+  double sum = 0.0;
+  for (std::size_t i = static_cast<std::size_t>(c); i < rgba.size(); i += 4) sum += rgba[i];
+  return sum / static_cast<double>(rgba.size() / 4) / 255.0;
+}
+
+StereoSourceRequest request_for(const std::string& input, ViewBlockChooser choose) {
+  return StereoSourceRequest{input, "", StereoLayout::sbs, false, std::nullopt, true, false, std::move(choose)};
+}
+
+// Red left view, blue right view, 64×36 each, 20 frames at 10 fps.
+std::string make_sbs_clip(const TempDir& dir) {
+  return make_media(dir / "sbs.mkv", test::two_colour_input(64, 36, false, 20, 10) + " -c:v ffv1 -pix_fmt yuv420p")
+      .string();
+}
+
+void expect_views(const StereoVideoFrame& f, std::array<int, 2> block) {
+  EXPECT_EQ(f.width, 64);
+  EXPECT_EQ(f.height, 36);
+  EXPECT_EQ(f.block, block);
+  const std::size_t bytes = static_cast<std::size_t>(64 / block[0]) * (36 / block[1]) * 4;
+  ASSERT_EQ(f.left.size(), bytes);
+  ASSERT_EQ(f.right.size(), bytes);
+  EXPECT_GT(channel_mean(f.left, 0), 0.9);
+  EXPECT_LT(channel_mean(f.left, 2), 0.1);
+  EXPECT_GT(channel_mean(f.right, 2), 0.9);
+  EXPECT_LT(channel_mean(f.right, 0), 0.1);
+}
+
+TEST_F(StereoFrameSourceTest, DeliversTheRequestedBlockMeansFromTheFirstFrameOn) {
+  std::vector<std::array<double, 3>> asked;
+  auto source = open_stereo_frame_source(request_for(make_sbs_clip(dir), [&](int w, int h, double aspect) {
+    asked.push_back({static_cast<double>(w), static_cast<double>(h), aspect});
+    return std::array<int, 2>{4, 4};
+  }));
+  ASSERT_EQ(asked.size(), 1u);
+  EXPECT_EQ(asked[0][0], 64);  // the view, not the frame
+  EXPECT_EQ(asked[0][1], 36);
+  const auto first = source->next();
+  ASSERT_TRUE(first);
+  expect_views(*first, {4, 4});
+  EXPECT_NEAR(first->pts_s, 0.0, 1e-6);
+}
+
+TEST_F(StereoFrameSourceTest, ASeekKeepsTheViewsReduced) {
+  auto source = open_stereo_frame_source(request_for(make_sbs_clip(dir), [](int, int, double) {
+    return std::array<int, 2>{2, 3};
+  }));
+  ASSERT_TRUE(source->next());
+  ASSERT_TRUE(source->next());
+  source->seek(1.0);
+  const auto after = source->next();
+  ASSERT_TRUE(after);
+  EXPECT_NEAR(after->pts_s, 1.0, 1e-6);
+  expect_views(*after, {2, 3});
+  source->seek(0.0);  // back to the start, as a player does
+  const auto again = source->next();
+  ASSERT_TRUE(again);
+  EXPECT_NEAR(again->pts_s, 0.0, 1e-6);
+  expect_views(*again, {2, 3});
+}
+
+TEST_F(StereoFrameSourceTest, TheBlockCanChangeMidStreamAndBackToWholeViews) {
+  auto source = open_stereo_frame_source(request_for(make_sbs_clip(dir), {}));
+  const auto whole = source->next();
+  ASSERT_TRUE(whole);
+  expect_views(*whole, {1, 1});
+  EXPECT_EQ(source->reduce_views([](int, int, double) {
+    return std::array<int, 2>{4, 2};
+  }),
+            (std::array<int, 2>{4, 2}));
+  const auto reduced = source->next();
+  ASSERT_TRUE(reduced);
+  EXPECT_NEAR(reduced->pts_s, 0.1, 1e-6);  // no frame lost or repeated by the change
+  expect_views(*reduced, {4, 2});
+  EXPECT_EQ(source->reduce_views({}), (std::array<int, 2>{1, 1}));
+  const auto back = source->next();
+  ASSERT_TRUE(back);
+  EXPECT_NEAR(back->pts_s, 0.2, 1e-6);
+  expect_views(*back, {1, 1});
+}
+
+TEST_F(StereoFrameSourceTest, ABlockThatDoesNotDivideTheViewGivesWholeViews) {
+  auto source = open_stereo_frame_source(request_for(make_sbs_clip(dir), [](int, int, double) {
+    return std::array<int, 2>{5, 5};
+  }));
+  const auto f = source->next();
+  ASSERT_TRUE(f);
+  expect_views(*f, {1, 1});
+}
+
+TEST_F(StereoFrameSourceTest, ChangingTheBlockBeforeTheFirstFrameReconvertsIt) {
+  // The first frame is decoded while opening (layout detection); asking afterwards must not hand
+  // it out at the old size.
+  auto source = open_stereo_frame_source(request_for(make_sbs_clip(dir), {}));
+  EXPECT_EQ(source->reduce_views([](int, int, double) {
+    return std::array<int, 2>{2, 2};
+  }),
+            (std::array<int, 2>{2, 2}));
+  const auto first = source->next();
+  ASSERT_TRUE(first);
+  EXPECT_NEAR(first->pts_s, 0.0, 1e-6);
+  expect_views(*first, {2, 2});
+}
+
+TEST_F(StereoFrameSourceTest, SyntheticSourceAlwaysDeliversWholeViews) {
+  auto source = open_stereo_frame_source(request_for("synthetic:duration=1", [](int, int, double) {
+    return std::array<int, 2>{2, 2};
+  }));
+  EXPECT_EQ(source->reduce_views([](int, int, double) {
+    return std::array<int, 2>{2, 2};
+  }),
+            (std::array<int, 2>{1, 1}));
+  const auto f = source->next();
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->block, (std::array<int, 2>{1, 1}));
+  EXPECT_EQ(f->left.size(), static_cast<std::size_t>(f->width) * f->height * 4);
+}
+
+}  // namespace
+}  // namespace nelf
