@@ -664,7 +664,11 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     bool finished = false;
     if (!awaiting_seek && (!(paused && started) || show_while_paused)) {
       // When this refresh will be seen: after the next vblank, or once rendered and presented.
-      const double visible_at = clock->now() + (display.vsync() ? refresh_period : render_s);
+      double visible_at = clock->now() + (display.vsync() ? refresh_period : render_s);
+      // The clock waits, paused, for the first frame to be on screen; a stream whose video starts
+      // later than its sound (mkv: video at 0.023 s, audio at 0) would wait for it for ever. The
+      // first frame is the poster shown while the clock waits, whenever its pts.
+      if (!started && !queued.empty()) visible_at = std::max(visible_at, queued.front());
       const FrameDecision d = scheduler.decide(visible_at, queued, end);
       if (d.drop > 0 || d.show_front) {
         auto frame = queue.pop(d.drop, d.show_front);
