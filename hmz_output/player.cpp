@@ -38,16 +38,18 @@ class FrameQueue {
  public:
   explicit FrameQueue(std::size_t capacity) : capacity_(capacity) {}
 
-  // Decode thread: waits for room (or a seek, or stop). Returns the seek target if one is pending.
+  // Decode thread: waits for room (or a seek, a new reduction, or stop). Returns the seek target
+  // and the reduction if one is pending.
   struct Work {
     std::optional<double> seek_to;
+    std::optional<ViewBlockChooser> reduce;
     std::uint64_t generation = 0;
     bool stop = false;
   };
   Work wait_for_work() {
     std::unique_lock lock(mutex_);
-    changed_.wait(lock, [&] { return stop_ || seek_to_ || (!end_ && items_.size() < capacity_); });
-    Work work{std::exchange(seek_to_, std::nullopt), generation_, stop_};
+    changed_.wait(lock, [&] { return stop_ || seek_to_ || reduce_ || (!end_ && items_.size() < capacity_); });
+    Work work{std::exchange(seek_to_, std::nullopt), std::exchange(reduce_, std::nullopt), generation_, stop_};
     return work;
   }
   void push(StereoVideoFrame frame, std::uint64_t generation) {
@@ -75,6 +77,13 @@ class FrameQueue {
     ++generation_;
     items_.clear();
     end_ = false;
+    changed_.notify_all();
+  }
+  // The views of frames decoded from now on as `choose` says (StereoFrameSource::reduce_views);
+  // frames already queued keep theirs.
+  void reduce_views(ViewBlockChooser choose) {
+    std::lock_guard lock(mutex_);
+    reduce_ = std::move(choose);
     changed_.notify_all();
   }
   void stop() {
@@ -118,6 +127,7 @@ class FrameQueue {
   std::deque<StereoVideoFrame> items_;
   std::size_t capacity_;
   std::optional<double> seek_to_;
+  std::optional<ViewBlockChooser> reduce_;
   std::uint64_t generation_ = 0;
   bool end_ = false, stop_ = false;
   std::exception_ptr error_;
@@ -132,6 +142,7 @@ void decode_loop(StereoFrameSource& source, FrameQueue& queue) {
     for (;;) {
       const FrameQueue::Work work = queue.wait_for_work();
       if (work.stop) return;
+      if (work.reduce) source.reduce_views(*work.reduce);
       if (work.seek_to) {
         source.seek(*work.seek_to);
         continue;
@@ -227,24 +238,52 @@ class AudioFeeder {
 
 // The calibration overlay: `nelf calibrate`'s grid pattern (lines 16 cells across, a yellow centre
 // cross, the eye's letter) drawn over the view, so that the eyes' alignment and the lens grid can
-// be judged on the movie itself. `pattern` is the grid as RGBA float at the view's size.
-void draw_over(std::vector<std::uint8_t>& pixels, const Image& pattern, int bits) {
-  const std::size_t n = static_cast<std::size_t>(pattern.width()) * pattern.height();
-  const float* p = pattern.data();
+// be judged on the movie itself. `cover` is the grid at the texture's size (cover_grid): where its
+// alpha is 1 the grid replaces the movie, where 0 the movie shows through.
+void draw_over(std::vector<std::uint8_t>& pixels, const Image& cover, int bits) {
+  const std::size_t n = static_cast<std::size_t>(cover.width()) * cover.height();
+  const float* p = cover.data();
   for (std::size_t i = 0; i < n; ++i) {
-    const float r = p[i * 4], g = p[i * 4 + 1], b = p[i * 4 + 2];
-    if (std::max({r, g, b}) < 0.02f) continue;  // black: the movie shows through
-    const float rgb[3] = {r, g, b};
-    for (int c = 0; c < 3; ++c) {
-      const float v = std::clamp(rgb[c], 0.f, 1.f);
+    const float a = p[i * 4 + 3];
+    if (a <= 0.f) continue;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const float grid = std::clamp(p[i * 4 + c], 0.f, 1.f);
       if (bits > 8) {
-        const auto u = static_cast<std::uint16_t>(std::lround(v * 65535.f));
-        std::memcpy(&pixels[i * 8 + static_cast<std::size_t>(c) * 2], &u, 2);
+        std::uint16_t u = 0;
+        std::memcpy(&u, &pixels[i * 8 + c * 2], 2);
+        u = static_cast<std::uint16_t>(std::lround((u / 65535.f * (1.f - a) + grid * a) * 65535.f));
+        std::memcpy(&pixels[i * 8 + c * 2], &u, 2);
       } else {
-        pixels[i * 4 + static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(std::lround(v * 255.f));
+        pixels[i * 4 + c] =
+            static_cast<std::uint8_t>(std::lround((pixels[i * 4 + c] / 255.f * (1.f - a) + grid * a) * 255.f));
       }
     }
   }
+}
+
+// The full-size grid `pattern` as drawn over block means of `block` pixels: per block, alpha = the
+// share of its pixels the grid covers (not black), colour = their mean. Blending that over the
+// block mean of the movie gives exactly the block mean of the grid drawn over the full view, so
+// the lines look as they do without the reduction (at 1×1: the grid as is, alpha 0 or 1).
+Image cover_grid(const Image& pattern, std::array<int, 2> block) {
+  Image out(pattern.width() / block[0], pattern.height() / block[1]);
+  const float per_block = 1.f / static_cast<float>(block[0] * block[1]);
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x) {
+      Rgba sum{0.f, 0.f, 0.f, 0.f};
+      for (int by = 0; by < block[1]; ++by)
+        for (int bx = 0; bx < block[0]; ++bx) {
+          const Rgba& q = pattern.at(x * block[0] + bx, y * block[1] + by);
+          if (std::max({q.r, q.g, q.b}) < 0.02f) continue;  // black: the movie shows through
+          sum.r += q.r;
+          sum.g += q.g;
+          sum.b += q.b;
+          sum.a += 1.f;
+        }
+      Rgba& o = out.at(x, y);
+      o = sum.a > 0.f ? Rgba{sum.r / sum.a, sum.g / sum.a, sum.b / sum.a, sum.a * per_block} : Rgba{0.f, 0.f, 0.f, 0.f};
+    }
+  return out;
 }
 
 // The GL side: view textures, the compositor (rebuilt when the optics change) and the eye areas.
@@ -269,14 +308,19 @@ class PackedRenderer {
   }
   const Profile& profile() const { return profile_; }
 
+  // The frame's views into the view textures: whole views, or (frame.block > 1×1) the block means
+  // the compositor's prefilter starts from, 1/block² of the texels to upload and composite.
   void upload(const StereoVideoFrame& frame, bool calibration) {
-    if (frame.width != view_w_ || frame.height != view_h_ || frame.bits != bits_) {
+    if (frame.width != view_w_ || frame.height != view_h_ || frame.bits != bits_ || frame.block != block_ ||
+        frame.aspect != aspect_) {
       view_w_ = frame.width;
       view_h_ = frame.height;
       bits_ = frame.bits;
-      for (auto& t : views_) t = gl::make_texture_2d(bits_ > 8 ? GL_RGBA16 : GL_RGBA8, view_w_, view_h_);
+      block_ = frame.block;
+      aspect_ = frame.aspect;
+      for (auto& t : views_) t = gl::make_texture_2d(bits_ > 8 ? GL_RGBA16 : GL_RGBA8, texture_w(), texture_h());
+      update_wanted_blocks();
     }
-    aspect_ = frame.aspect;
     const GLenum type = bits_ > 8 ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     for (int i = 0; i < 2; ++i) {
@@ -284,22 +328,28 @@ class PackedRenderer {
       if (calibration) {
         std::vector<std::uint8_t> copy = source;
         draw_over(copy, calibration_grid(i), bits_);
-        glTextureSubImage2D(views_[i].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, copy.data());
+        glTextureSubImage2D(views_[i].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, copy.data());
       } else {
-        glTextureSubImage2D(views_[i].id(), 0, 0, 0, view_w_, view_h_, GL_RGBA, type, source.data());
+        glTextureSubImage2D(views_[i].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, source.data());
       }
     }
     gl::check_error("uploading the views");
   }
 
-  // The grid for view `i` at the current view size and optics (made when first needed).
+  // The block each eye's prefilter wants for the current views and optics ({1, 1}: whole views).
+  std::array<int, 2> wanted_block(Eye eye) const { return wanted_blocks_[static_cast<int>(eye)]; }
+
+  // The grid for view `i` at the view's size and the current optics, as cover for the view
+  // texture (cover_grid: block means of it on reduced views). Made when first needed.
   const Image& calibration_grid(int i) {
     const PatternGeometry geometry = pattern_geometry(profile_, view_w_, view_h_);
-    if (!grid_ || !(grid_geometry_ == geometry)) {
-      grid_ = make_test_pattern(TestPattern::grid, geometry);
+    if (!grid_ || !(grid_geometry_ == geometry) || grid_block_ != block_) {
+      const StereoPair pair = make_test_pattern(TestPattern::grid, geometry);
+      grid_ = {cover_grid(pair.left.image, block_), cover_grid(pair.right.image, block_)};
       grid_geometry_ = geometry;
+      grid_block_ = block_;
     }
-    return i == 0 ? grid_->left.image : grid_->right.image;
+    return (*grid_)[static_cast<std::size_t>(i)];
   }
 
   // The on-screen message ("" for none), blended into both views before compositing so that it
@@ -316,15 +366,34 @@ class PackedRenderer {
       const auto& origin = origins_[static_cast<int>(eye)];
       if (!origin) continue;
       const int view = static_cast<int>(eye) ^ (swap_eyes ? 1 : 0);
-      const GlTextureView shown = overlay_.apply(eye, GlTextureView{views_[view].id(), view_w_, view_h_, aspect_});
-      compositor_->render_eye(eye, shown, GlTarget{fbo, origin->first, origin->second});
+      // The text goes onto the texture as it is (block means: at their size, where it is as sharp
+      // as the prefilter would leave full-size text, and its cap height still 1/20 of the view).
+      const GlTextureView shown =
+          overlay_.apply(eye, GlTextureView{views_[view].id(), texture_w(), texture_h(),
+                                            aspect_ > 0.0 ? aspect_ : double(view_w_) / view_h_});
+      const GlTarget target{fbo, origin->first, origin->second};
+      if (reduced() && block_ == wanted_block(eye))
+        compositor_->render_eye_reduced(eye, GlReducedView{{shown.texture, view_w_, view_h_, aspect_}, block_}, target);
+      else  // whole views, or block means made for optics changed since (a key): a smaller view
+        compositor_->render_eye(eye, shown, target);
     }
   }
 
  private:
+  bool reduced() const { return block_[0] > 1 || block_[1] > 1; }
+  int texture_w() const { return view_w_ / block_[0]; }
+  int texture_h() const { return view_h_ / block_[1]; }
+  void update_wanted_blocks() {
+    for (Eye eye : {Eye::left, Eye::right})
+      wanted_blocks_[static_cast<int>(eye)] =
+          view_w_ > 0 ? prefilter_block(profile_, options_.compositor, eye, view_w_, view_h_, aspect_)
+                      : std::array<int, 2>{1, 1};
+  }
+
   void rebuild() {
     compositor_.reset();
     compositor_ = std::make_unique<GlCompositor>(profile_, options_.compositor, display_.context());
+    update_wanted_blocks();
     const auto panel = compositor_->panel();
     const auto packed = display_.packed_size();
     for (Eye eye : {Eye::left, Eye::right}) {
@@ -349,11 +418,14 @@ class PackedRenderer {
   Profile profile_;
   std::unique_ptr<GlCompositor> compositor_;
   TextOverlay overlay_;
-  std::optional<StereoPair> grid_;
+  std::optional<std::array<Image, 2>> grid_;
   PatternGeometry grid_geometry_;
+  std::array<int, 2> grid_block_{1, 1};
   std::array<std::optional<std::pair<int, int>>, 2> origins_;
   std::array<gl::Texture, 2> views_;
   int view_w_ = 0, view_h_ = 0, bits_ = 8;
+  std::array<int, 2> block_{1, 1};  // of the views in the textures
+  std::array<std::array<int, 2>, 2> wanted_blocks_{};
   double aspect_ = 0.0;
 };
 
@@ -454,6 +526,14 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   const double refresh_period = 1.0 / display.refresh_hz();
   const double fps = source.frame_rate();
   FrameScheduler scheduler(refresh_period, fps > 0 ? 1.0 / fps : 0.0);
+  // Views as the prefilter's block means where the input allows (swscale makes them while
+  // converting from YUV): far less to convert, upload and composite per frame.
+  const auto blocks_for = [&options](const Profile& profile) -> ViewBlockChooser {
+    return [profile, compositor = options.compositor](int width, int height, double aspect) {
+      return stereo_prefilter_block(profile, compositor, width, height, aspect);
+    };
+  };
+  source.reduce_views(blocks_for(options.profile));
   FrameQueue queue(6);
   std::jthread decoder([&] { decode_loop(source, queue); });
   struct StopDecoder {
@@ -499,6 +579,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   auto change_profile = [&](Profile changed, const std::string& what) {
     try {
       renderer.set_profile(changed);
+      queue.reduce_views(blocks_for(changed));  // the block follows the optics
       dirty = true;
       say(what);
     } catch (const std::exception& e) {

@@ -174,5 +174,83 @@ TEST_F(PlayerWindowTest, ClosingTheWindowEndsPlaybackCleanly) {
   EXPECT_EQ(result.counters.shown, 3);
 }
 
+// A source that records the block of each frame it hands out; with `allow_reduction` false it
+// ignores reduce_views (whole views, as before the player asked for block means).
+class RecordingSource final : public StereoFrameSource {
+ public:
+  RecordingSource(std::unique_ptr<StereoFrameSource> inner, bool allow_reduction)
+      : inner_(std::move(inner)), allow_(allow_reduction) {}
+  std::optional<StereoVideoFrame> next() override {
+    auto f = inner_->next();
+    if (f) blocks.push_back(f->block);
+    return f;
+  }
+  double frame_rate() const override { return inner_->frame_rate(); }
+  std::optional<long> expected_frames() const override { return inner_->expected_frames(); }
+  std::optional<double> duration_s() const override { return inner_->duration_s(); }
+  void seek(double seconds) override { inner_->seek(seconds); }
+  std::array<int, 2> reduce_views(const ViewBlockChooser& choose) override {
+    return allow_ ? inner_->reduce_views(choose) : std::array<int, 2>{1, 1};
+  }
+  std::vector<std::array<int, 2>> blocks;
+
+ private:
+  std::unique_ptr<StereoFrameSource> inner_;
+  bool allow_;
+};
+
+TEST_F(PlayerWindowTest, PlaysFromTheCompositorsBlockMeansWithTheSameImageAsFromWholeViews) {
+  const auto clip = make_clip(dir_);
+  PlayerOptions options;
+  options.profile = small_profile(dir_);
+  options.signal = *find_signal("hdmi-fp-720p60");
+  options.audio = false;
+  options.quiet = true;
+  const auto wanted = stereo_prefilter_block(options.profile, options.compositor, 320, 180, 0.0);
+  ASSERT_TRUE(wanted[0] > 1 || wanted[1] > 1) << "the test profile should make the compositor average blocks";
+  DisplayOptions display_options;
+  display_options.signal = options.signal;
+  display_options.packed = {options.signal.packed_width(160), options.signal.packed_height(90)};
+  auto display = open_window_display(display_options);
+  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
+  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
+
+  // The first frame, played once from block means and once from whole views.
+  std::vector<Image> shown;
+  std::atomic<bool> stop{false};
+  options.after_render = [&](const Display& d, double) {
+    shown.push_back(read_back(d.packed_framebuffer(), 0, 0, display_options.packed[0], display_options.packed[1]));
+    stop = true;
+  };
+  std::vector<std::array<int, 2>> blocks[2];
+  for (bool reduce : {true, false}) {
+    stop = false;
+    RecordingSource source(open_stereo_frame_source(StereoSourceRequest{
+                               clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}}),
+                           reduce);
+    play(*display, source, options, &stop);
+    blocks[reduce ? 0 : 1] = source.blocks;
+  }
+  ASSERT_EQ(shown.size(), 2u);
+  ASSERT_FALSE(blocks[0].empty());
+  for (const auto& b : blocks[0]) EXPECT_EQ(b, wanted);
+  for (const auto& b : blocks[1]) EXPECT_EQ(b, (std::array<int, 2>{1, 1}));
+  // Same picture in both eyes' panels (rounding-level differences only).
+  for (const EyeArea& a : {left, right}) {
+    double sum = 0.0, worst = 0.0;
+    const int x0 = a.x + (a.width - 160) / 2, y0 = a.y + (a.height - 90) / 2;
+    for (int y = y0; y < y0 + 90; ++y)
+      for (int x = x0; x < x0 + 160; ++x)
+        for (int c = 0; c < 3; ++c) {
+          const std::size_t i = (static_cast<std::size_t>(y) * shown[0].width() + x) * 4 + c;
+          const double d = std::abs(shown[0].data()[i] - shown[1].data()[i]);
+          sum += d;
+          worst = std::max(worst, d);
+        }
+    EXPECT_LT(sum / (160.0 * 90 * 3), 0.01);
+    EXPECT_LT(worst, 0.15);
+  }
+}
+
 }  // namespace
 }  // namespace nelf
