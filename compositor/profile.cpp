@@ -384,11 +384,21 @@ Profile load_profile(const std::string& name_or_path) {
   return p;
 }
 
+namespace {
+// A TOML basic string with quotes, backslashes and control characters escaped (toml++'s formatter),
+// so that any name, description or path read from a profile is written back loadable.
+std::string toml_string(const std::string& text) {
+  std::ostringstream quoted;
+  quoted << toml::value<std::string>(text);
+  return quoted.str();
+}
+}  // namespace
+
 std::string profile_to_toml(const Profile& p) {
   const auto pair = [](Vec2 v) { return fmt::format("[{}, {}]", v.x, v.y); };
   std::string out;
-  out += fmt::format("name = \"{}\"\n", p.name);
-  if (!p.description.empty()) out += fmt::format("description = \"{}\"\n", p.description);
+  out += fmt::format("name = {}\n", toml_string(p.name));
+  if (!p.description.empty()) out += fmt::format("description = {}\n", toml_string(p.description));
   out += fmt::format("\n[display]\nresolution = [{}, {}]\n", p.display.resolution[0], p.display.resolution[1]);
   if (p.display.pixel_pitch_mm.x == p.display.pixel_pitch_mm.y)
     out += fmt::format("pixel_pitch_mm = {}\n", p.display.pixel_pitch_mm.x);
@@ -407,14 +417,14 @@ std::string profile_to_toml(const Profile& p) {
                      p.viewing.eye_relief_mm, p.viewing.virtual_image_mm, p.viewing.pupil_mm, p.viewing.ipd_mm);
   out += fmt::format("\n[screen]\ndistance_mm = {}\nwidth_mm = {}\nconverge = {}\n", p.screen.distance_mm,
                      p.screen.width_mm, p.screen.converge);
-  out += fmt::format("\n[output]\nsignal = \"{}\"\n", p.signal);
+  out += fmt::format("\n[output]\nsignal = {}\n", toml_string(p.signal));
   for (Eye eye : {Eye::left, Eye::right}) {
     const auto& c = p.eye_calibration(eye);
     out += fmt::format("\n[calibration.{}]\nshift_px = {}\nrotation_deg = {}\npitch_scale = {}\n",
                        eye == Eye::left ? "left" : "right", pair(c.shift_px), c.rotation_deg, c.pitch_scale);
   }
-  out += fmt::format("\n[correction]\nprescription_diopters = {}\ndefect_map = \"{}\"\n",
-                     p.correction.prescription_diopters, p.correction.defect_map);
+  out += fmt::format("\n[correction]\nprescription_diopters = {}\ndefect_map = {}\n",
+                     p.correction.prescription_diopters, toml_string(p.correction.defect_map));
   out += fmt::format("\n[magnifier_comparison]\neye_box_mm = {}\nf_number = {}\n", p.magnifier_comparison.eye_box_mm,
                      p.magnifier_comparison.f_number);
   return out;

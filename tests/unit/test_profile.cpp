@@ -88,6 +88,16 @@ TEST(Profile, RoundTripsThroughToml) {
   EXPECT_EQ(q.description, p.description);
 }
 
+TEST(Profile, RoundTripsNamesWithQuotesAndBackslashes) {
+  // A profile named by its user (nelf calibrate --save) may hold any text; it must load again.
+  Profile p = load_profile("hmz-t1");
+  p.name = R"(my "tuned" HMZ \ v2)";
+  p.description = "line one\nline \"two\"\ttab";
+  const Profile q = parse_profile(profile_to_toml(p), "saved.toml");
+  EXPECT_EQ(q.name, p.name);
+  EXPECT_EQ(q.description, p.description);
+}
+
 TEST(ProfileErrors, SyntaxErrorNamesFileAndLine) {
   const auto e = error_of("name = \"x\"\n[display\nresolution = [1,2]\n");
   EXPECT_NE(e.find("dev.toml:2"), std::string::npos) << e;
