@@ -13,17 +13,11 @@
 namespace nelf {
 namespace {
 
+using test::files_in;
 using test::read_back;
 using test::run_nelf;
 using test::shell_quote;
 using test::TempDir;
-
-std::vector<std::string> files_in(const std::filesystem::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
 
 float luma(const test::ReadBack& img, int x, int y) {
   return (img.at(x, y, 0) + img.at(x, y, 1) + img.at(x, y, 2)) / 3.f;

@@ -14,19 +14,14 @@
 namespace nelf {
 namespace {
 
+using test::expect_clean_failure;
+using test::files_in;
 using test::filled_image;
 using test::read_back;
 using test::run_nelf;
 using test::shell_quote;
 using test::TempDir;
 using test::write_test_image;
-
-std::vector<std::string> files_in(const std::filesystem::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
 
 // A stereo view with structure (stripes) so that the elemental images are not flat: the left one
 // reddish, the right one bluish.
@@ -216,21 +211,6 @@ TEST(ConvertStills, EveryStillFormatRoutesTheEyes) {
             0);
   const auto img = read_back(swapped);
   EXPECT_GT(stats(img, 0, 0, 160, 90).blue, 3 * stats(img, 0, 0, 160, 90).red);
-}
-
-// Runs a failing conversion and checks the contract: status, exactly one line on stderr that
-// contains `expected`, and the directory exactly as it was (no output, no temporary file).
-void expect_clean_failure(const TempDir& dir, const std::string& args, int status, const std::string& expected) {
-  SCOPED_TRACE(args);
-  const auto before = files_in(dir.path());
-  const auto r = run_nelf(args);
-  EXPECT_EQ(r.status, status) << r.err;
-  EXPECT_EQ(r.out, "");
-  ASSERT_FALSE(r.err.empty());
-  EXPECT_EQ(r.err.rfind("nelf: ", 0), 0u) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
-  EXPECT_EQ(files_in(dir.path()), before);
 }
 
 TEST(ConvertStills, BadInputFiles) {

@@ -20,13 +20,6 @@ namespace {
 
 std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
 
-std::vector<std::string> files_in(const std::filesystem::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
 std::filesystem::path small_profile(const TempDir& dir) { return test::write_small_profile(dir); }
 
 const std::string h264 = " -c:v libx264 -preset ultrafast -pix_fmt yuv420p";
@@ -316,22 +309,6 @@ TEST(ConvertVideo, SyntheticClipWithAudio) {
 }
 
 // ---------------------------------------------------------------------------------------------
-
-// A failing conversion: `status`, exactly one "nelf: " line on stderr containing `expected`, no
-// crash, and the directory exactly as it was (no output, no temporary file).
-void expect_clean_failure(const TempDir& dir, const std::string& args, int status, const std::string& expected) {
-  SCOPED_TRACE(args);
-  const auto before = files_in(dir.path());
-  const auto r = run_nelf(args);
-  EXPECT_EQ(r.status, status) << r.err;
-  EXPECT_LT(r.status, 128) << "killed by a signal";
-  EXPECT_EQ(r.out, "");
-  ASSERT_FALSE(r.err.empty());
-  EXPECT_EQ(r.err.rfind("nelf: ", 0), 0u) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
-  EXPECT_EQ(files_in(dir.path()), before);
-}
 
 TEST(ConvertVideo, BadInputs) {
   TempDir dir;

@@ -1,6 +1,9 @@
 #include "support/test_support.hpp"
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
+
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <fstream>
@@ -85,5 +88,28 @@ virtual_image_mm = 1000.0
 )");
   return path;
 }
+
+std::vector<std::string> files_in(const std::filesystem::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+#ifdef NELF_BINARY
+void expect_clean_failure(const TempDir& dir, const std::string& args, int status, const std::string& expected) {
+  SCOPED_TRACE(args);
+  const auto before = files_in(dir.path());
+  const auto r = run_nelf(args);
+  EXPECT_EQ(r.status, status) << r.err;
+  EXPECT_LT(r.status, 128) << "killed by a signal";
+  EXPECT_EQ(r.out, "");
+  ASSERT_FALSE(r.err.empty());
+  EXPECT_EQ(r.err.rfind("nelf: ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  EXPECT_EQ(files_in(dir.path()), before);
+}
+#endif
 
 }  // namespace nelf::test

@@ -2,6 +2,7 @@
 // Helpers shared by the tests: temporary directories, running the nelf binary, small profiles.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace nelf::test {
 
@@ -19,6 +20,9 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+// The names of the entries of `dir`, sorted (to check that nothing was left behind).
+std::vector<std::string> files_in(const std::filesystem::path& dir);
+
 // Writes `text` to `path` (creating or replacing it).
 void write_file(const std::filesystem::path& path, const std::string& text);
 std::string read_file(const std::filesystem::path& path);
@@ -35,6 +39,11 @@ CommandResult run_command(const std::string& command_line);
 #ifdef NELF_BINARY
 // Runs `nelf ARGS` (ARGS is a shell-quoted string).
 inline CommandResult run_nelf(const std::string& args) { return run_command(std::string(NELF_BINARY) + " " + args); }
+
+// Runs a failing `nelf ARGS` and checks the contract of DESIGN.md §11: `status` (not a signal),
+// nothing on stdout, exactly one line on stderr starting "nelf: " and containing `expected`, and
+// `dir` exactly as it was (no output, no temporary file).
+void expect_clean_failure(const TempDir& dir, const std::string& args, int status, const std::string& expected);
 #endif
 
 // Quotes a string for /bin/sh.

@@ -11,14 +11,8 @@
 namespace nelf {
 namespace {
 
+using test::files_in;
 using test::TempDir;
-
-std::vector<std::string> files_in(const std::filesystem::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
 
 std::string write_error(const Image& image, const std::filesystem::path& path, ImageWriteOptions options = {}) {
   try {
