@@ -58,20 +58,30 @@ class PlayerWindowTest : public ::testing::Test {
   test::XvfbServer xvfb_;
   test::ScopedDisplay display_env_{xvfb_.display_name()};
   test::TempDir dir_;
+
+  // The small test panel on the HMZ-T1's signal, without sound or messages.
+  PlayerOptions silent_options() const {
+    PlayerOptions options;
+    options.profile = small_profile(dir_);
+    options.signal = *find_signal("hdmi-fp-720p60");
+    options.audio = false;
+    options.quiet = true;
+    return options;
+  }
+  // A window showing the packed frame of `options`' 160x90 panel.
+  static std::unique_ptr<Display> open_display(const PlayerOptions& options) {
+    DisplayOptions display_options;
+    display_options.signal = options.signal;
+    display_options.packed = {options.signal.packed_width(160), options.signal.packed_height(90)};
+    return open_window_display(display_options);
+  }
 };
 
 TEST_F(PlayerWindowTest, PlaysTheClipInThePackedLayoutWithEachEyesContentAndFramesAdvance) {
   const auto clip = make_clip(dir_);
-  PlayerOptions options;
-  options.profile = small_profile(dir_);
-  options.signal = *find_signal("hdmi-fp-720p60");
-  options.audio = false;
-  options.quiet = true;
+  PlayerOptions options = silent_options();
 
-  DisplayOptions display_options;
-  display_options.signal = options.signal;
-  display_options.packed = {options.signal.packed_width(160), options.signal.packed_height(90)};
-  auto display = open_window_display(display_options);
+  auto display = open_display(options);
 
   const auto left = *eye_area(options.signal, Eye::left, 160, 90);
   const auto right = *eye_area(options.signal, Eye::right, 160, 90);
@@ -122,15 +132,8 @@ TEST_F(PlayerWindowTest, PlaysTheClipInThePackedLayoutWithEachEyesContentAndFram
 
 TEST_F(PlayerWindowTest, SwapEyesPutsTheFirstStoredViewOnTheRight) {
   const auto clip = make_clip(dir_);
-  PlayerOptions options;
-  options.profile = small_profile(dir_);
-  options.signal = *find_signal("hdmi-fp-720p60");
-  options.audio = false;
-  options.quiet = true;
-  DisplayOptions display_options;
-  display_options.signal = options.signal;
-  display_options.packed = {options.signal.packed_width(160), options.signal.packed_height(90)};
-  auto display = open_window_display(display_options);
+  PlayerOptions options = silent_options();
+  auto display = open_display(options);
   const auto left = *eye_area(options.signal, Eye::left, 160, 90);
   std::vector<Mean> left_means;
   options.after_render = [&](const Display& d, double) {
@@ -153,15 +156,8 @@ TEST_F(PlayerWindowTest, SwapEyesPutsTheFirstStoredViewOnTheRight) {
 
 TEST_F(PlayerWindowTest, ClosingTheWindowEndsPlaybackCleanly) {
   const auto clip = make_clip(dir_);
-  PlayerOptions options;
-  options.profile = small_profile(dir_);
-  options.signal = *find_signal("hdmi-fp-720p60");
-  options.audio = false;
-  options.quiet = true;
-  DisplayOptions display_options;
-  display_options.signal = options.signal;
-  display_options.packed = {options.signal.packed_width(160), options.signal.packed_height(90)};
-  auto display = open_window_display(display_options);
+  PlayerOptions options = silent_options();
+  auto display = open_display(options);
   int rendered = 0;
   // What the window manager's close button does to a GLFW window.
   options.after_render = [&](const Display&, double) {
@@ -201,17 +197,10 @@ class RecordingSource final : public StereoFrameSource {
 
 TEST_F(PlayerWindowTest, PlaysFromTheCompositorsBlockMeansWithTheSameImageAsFromWholeViews) {
   const auto clip = make_clip(dir_);
-  PlayerOptions options;
-  options.profile = small_profile(dir_);
-  options.signal = *find_signal("hdmi-fp-720p60");
-  options.audio = false;
-  options.quiet = true;
+  PlayerOptions options = silent_options();
   const auto wanted = stereo_prefilter_block(options.profile, options.compositor, 320, 180, 0.0);
   ASSERT_TRUE(wanted[0] > 1 || wanted[1] > 1) << "the test profile should make the compositor average blocks";
-  DisplayOptions display_options;
-  display_options.signal = options.signal;
-  display_options.packed = {options.signal.packed_width(160), options.signal.packed_height(90)};
-  auto display = open_window_display(display_options);
+  auto display = open_display(options);
   const auto left = *eye_area(options.signal, Eye::left, 160, 90);
   const auto right = *eye_area(options.signal, Eye::right, 160, 90);
 
@@ -219,7 +208,7 @@ TEST_F(PlayerWindowTest, PlaysFromTheCompositorsBlockMeansWithTheSameImageAsFrom
   std::vector<Image> shown;
   std::atomic<bool> stop{false};
   options.after_render = [&](const Display& d, double) {
-    shown.push_back(read_back(d.packed_framebuffer(), 0, 0, display_options.packed[0], display_options.packed[1]));
+    shown.push_back(read_back(d.packed_framebuffer(), 0, 0, d.packed_size()[0], d.packed_size()[1]));
     stop = true;
   };
   std::vector<std::array<int, 2>> blocks[2];
