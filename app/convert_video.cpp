@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <fmt/printf.h>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -225,7 +226,8 @@ class BufferPool {
 // reads it back for the encoder.
 class PackedFrameRenderer {
  public:
-  PackedFrameRenderer(const VideoConvertRequest& r, int view_w, int view_h, int bits, std::array<int, 2> block)
+  PackedFrameRenderer(const VideoConvertRequest& r, int view_w, int view_h, int bits, double aspect,
+                      std::array<int, 2> block)
       : compositor_(r.profile, r.compositor, std::make_shared<gl::EglContext>(gl::ContextOptions{r.compositor.gpu})),
         signal_(r.signal),
         view_w_(view_w),
@@ -246,6 +248,18 @@ class PackedFrameRenderer {
       origins_[static_cast<int>(eye)] = {area->x + (area->width - panel[0]) / 2,
                                          area->y + (area->height - panel[1]) / 2};
     }
+    // On a software rasteriser 8-bit block means are composited on the CPU from tables recorded
+    // once with the compositor's shaders (compositor/composite_table.hpp): several times cheaper
+    // than llvmpipe's passes. Everything else goes through GL.
+    if (bits == 8 && prefer_composite_table(compositor_.context())) {
+      for (Eye eye : {Eye::left, Eye::right}) {
+        if (!origins_[static_cast<int>(eye)]) continue;
+        tables_[static_cast<int>(eye)] = compositor_.make_composite_table(eye, view_w, view_h, aspect, block);
+        if (!tables_[static_cast<int>(eye)]) tables_ = {};
+        if (!tables_[static_cast<int>(eye)]) break;
+      }
+    }
+    if (tables_[0] || tables_[1]) return;
     const GLenum internal = bits > 8 ? GL_RGBA16 : GL_RGBA8;
     for (auto& t : views_) t = gl::make_texture_2d(internal, texture_w(), texture_h());
     packed_ = gl::make_texture_2d(internal, width_, height_);
@@ -255,6 +269,7 @@ class PackedFrameRenderer {
   int height() const { return height_; }
 
   PackedFrame render(const StereoVideoFrame& f, BufferPool& buffers) {
+    if (tables_[0] || tables_[1]) return render_from_tables(f, buffers);
     const GLenum type = bits_ > 8 ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glTextureSubImage2D(views_[0].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, f.left.data());
@@ -281,6 +296,30 @@ class PackedFrameRenderer {
   }
 
  private:
+  // The CPU path: both eyes from their tables straight into the packed frame, black around them.
+  PackedFrame render_from_tables(const StereoVideoFrame& f, BufferPool& buffers) {
+    PackedFrame out{width_, height_, 8, buffers.take(static_cast<std::size_t>(width_) * height_ * 4), f.pts_s};
+    const std::uint32_t black = opaque_black();
+    std::fill_n(reinterpret_cast<std::uint32_t*>(out.rgba.data()), static_cast<std::size_t>(width_) * height_, black);
+    const std::size_t stride = static_cast<std::size_t>(width_) * 4;
+    for (Eye eye : {Eye::left, Eye::right}) {
+      const int e = static_cast<int>(eye);
+      if (!origins_[e] || !tables_[e]) continue;
+      const auto& view = eye == Eye::left ? f.left : f.right;
+      const std::size_t view_stride = static_cast<std::size_t>(texture_w()) * 4;
+      tables_[e]->render(view.data(), view_stride,
+                         out.rgba.data() + origins_[e]->second * stride + static_cast<std::size_t>(origins_[e]->first) * 4,
+                         stride);
+    }
+    return out;
+  }
+  static std::uint32_t opaque_black() {
+    const std::uint8_t bytes[4] = {0, 0, 0, 255};
+    std::uint32_t value = 0;
+    std::memcpy(&value, bytes, 4);
+    return value;
+  }
+
   int texture_w() const { return view_w_ / block_[0]; }
   int texture_h() const { return view_h_ / block_[1]; }
 
@@ -290,6 +329,7 @@ class PackedFrameRenderer {
   std::array<int, 2> block_;
   int width_ = 0, height_ = 0;
   std::array<std::optional<std::pair<int, int>>, 2> origins_;
+  std::array<std::optional<CompositeTable>, 2> tables_;  // per eye, the CPU path
   std::array<gl::Texture, 2> views_;
   gl::Texture packed_;
   gl::Framebuffer packed_fbo_;
@@ -334,6 +374,7 @@ void convert_video(const VideoConvertRequest& r) {
   auto first = source->next();
   if (!first) throw UserError(fmt::format("{}: no frames to convert", r.input), 1);
   const int view_w = first->width, view_h = first->height, bits = first->bits;
+  const double aspect = first->aspect;
   const std::array<int, 2> block = first->block;
 
   std::optional<long> total = source->expected_frames();
@@ -373,7 +414,7 @@ void convert_video(const VideoConvertRequest& r) {
   // Composite thread: owns the GL context.
   std::jthread composite([&] {
     try {
-      PackedFrameRenderer renderer(r, view_w, view_h, bits, block);
+      PackedFrameRenderer renderer(r, view_w, view_h, bits, aspect, block);
       size_promise.set_value({renderer.width(), renderer.height()});
       while (auto frame = decoded.pop()) {
         if (interrupted || error.failed()) break;

@@ -1,5 +1,9 @@
 #include "compositor/gl_compositor.hpp"
 
+#include <cstdlib>
+#include <cstring>
+#include <string_view>
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -99,6 +103,9 @@ GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shar
   border_program_ =
       gl::make_program("border_strips.vert", "elemental.frag", subsamples + "#define NELF_AREA_SAMPLE 1\n");
   map_program_ = gl::make_program("fullscreen.vert", "elemental.frag", subsamples + "#define NELF_COORDINATE_MAP 1\n");
+  if (options_.fsaa == 1)
+    record_program_ = gl::make_program("border_strips.vert", "elemental.frag",
+                                       subsamples + "#define NELF_AREA_SAMPLE 1\n#define NELF_RECORD_TAPS 1\n");
   lookup_program_ = gl::make_program("fullscreen.vert", "elemental_lookup.frag");
   set_uniform_int(lookup_program_.id(), "u_map", 1);
   reduce_program_ = gl::make_program("fullscreen.vert", "prefilter_reduce.frag");
@@ -169,6 +176,58 @@ GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, i
   return t.output_texture.id();
 }
 
+// Where u_view's texels are for uv ∈ [0, 1] (the screen): the view itself (cut to black outside
+// the screen), or the prefiltered texture, whose margins already fade to black.
+GlCompositor::TextureTransform GlCompositor::prefiltered_transform(const PrefilterPlan& plan) {
+  TextureTransform t;
+  for (int axis = 0; axis < 2; ++axis) {
+    // uv ∈ [0, 1] covers the samples between the margins.
+    t.scale[axis] = f(static_cast<double>(plan.output[axis] - 2 * plan.margin[axis]) / plan.output[axis]);
+    t.offset[axis] = f(static_cast<double>(plan.margin[axis]) / plan.output[axis]);
+  }
+  t.cut_outside = false;
+  return t;
+}
+
+// The uniforms of elemental.frag and border_strips.vert: the eye's mapping (DESIGN.md §3), where
+// u_view's texels are, and the region's origin in the target.
+void GlCompositor::set_mapping_uniforms(GLuint p, const EyeMapping& m, const TextureTransform& texture, int x, int y) {
+  set_uniform(p, "u_texture_scale", texture.scale[0], texture.scale[1]);
+  set_uniform(p, "u_texture_offset", texture.offset[0], texture.offset[1]);
+  set_uniform_int(p, "u_cut_outside", texture.cut_outside ? 1 : 0);
+  set_uniform(p, "u_region_origin", f(x), f(y));
+  set_uniform(p, "u_panel", f(m.panel[0]), f(m.panel[1]));
+  set_uniform(p, "u_pixel_pitch", f(m.pixel_pitch_mm.x), f(m.pixel_pitch_mm.y));
+  set_uniform(p, "u_shift", f(m.shift_px.x), f(m.shift_px.y));
+  set_uniform(p, "u_rotation", f(m.rotation_cos), f(m.rotation_sin));
+  set_uniform_int(p, "u_has_lens_array", m.has_lens_array ? 1 : 0);
+  if (m.has_lens_array) {
+    set_uniform(p, "u_to_lens_plane", f(m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm)));
+    set_uniform(p, "u_lattice_offset", f(m.lattice_offset_mm.x), f(m.lattice_offset_mm.y));
+    set_uniform(p, "u_lens_pitch", f(m.lens_pitch_mm));
+    set_uniform_int(p, "u_first_lens", m.first_lens[0], m.first_lens[1]);
+    set_uniform_int(p, "u_lenses", m.lenses[0], m.lenses[1]);
+    set_uniform(p, "u_chief_ray_scale", f((m.render_distance_mm - m.eye_relief_mm) / m.gap_mm));
+    set_uniform(p, "u_screen_centre", f(m.screen_centre_mm.x), f(m.screen_centre_mm.y));
+    set_uniform(p, "u_screen_size", f(m.screen_size_mm.x), f(m.screen_size_mm.y));
+  } else {
+    set_uniform(p, "u_view_size", f(m.view_size_mm.x), f(m.view_size_mm.y));
+  }
+}
+
+// Renders the coordinate map (elemental.frag's mapping, pass 1's tap positions) of `m` into `map`.
+void GlCompositor::draw_coordinate_map(const EyeMapping& m, const TextureTransform& texture, CoordinateMap& map) {
+  map.fbo.reset();
+  map.texture = gl::make_texture_2d(GL_RG32F, m.panel[0], m.panel[1]);
+  map.fbo = gl::make_framebuffer(map.texture);
+  set_mapping_uniforms(map_program_.id(), m, texture, 0, 0);
+  glBindVertexArray(empty_vertex_array_.id());
+  glBindFramebuffer(GL_FRAMEBUFFER, map.fbo.id());
+  glViewport(0, 0, m.panel[0], m.panel[1]);
+  glUseProgram(map_program_.id());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
 void GlCompositor::render_eye(Eye eye, const GlTextureView& view, const GlTarget& target) {
   render(eye, view, {1, 1}, target);
 }
@@ -185,8 +244,7 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
   const int subsamples = subsamples_per_axis(options_.fsaa);
 
   GLuint source = view.texture;
-  float scale[2] = {1.f, 1.f}, offset[2] = {0.f, 0.f};
-  bool cut_outside = true;
+  TextureTransform texture;  // the view itself until prefiltered
   const PrefilterPlan plan =
       options_.fsaa != 0 ? plan_prefilter(m, view.width, view.height, subsamples) : PrefilterPlan{};
   // block 1×1: the view itself (the prefilter averages it); else it must be the plan's block.
@@ -198,12 +256,7 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
                     block[0], block[1], wanted_block[0], wanted_block[1]));
   if (plan.enabled) {
     source = prefilter(plan, view.texture, view.width, view.height, reduced, prefilter_targets_[static_cast<int>(eye)]);
-    for (int axis = 0; axis < 2; ++axis) {
-      // uv ∈ [0, 1] covers the samples between the margins.
-      scale[axis] = f(static_cast<double>(plan.output[axis] - 2 * plan.margin[axis]) / plan.output[axis]);
-      offset[axis] = f(static_cast<double>(plan.margin[axis]) / plan.output[axis]);
-    }
-    cut_outside = false;
+    texture = prefiltered_transform(plan);
   }
 
   // Pass 1 (every pixel): point samples. Pass 2 (fsaa >= 1, lens arrays): strips along the
@@ -215,41 +268,12 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
   const bool new_map =
       use_map && (!coordinate_maps_[e].texture || coordinate_maps_[e].width != view.width ||
                   coordinate_maps_[e].height != view.height || coordinate_maps_[e].aspect != view.aspect());
-  for (const GLuint p : {elemental_program_.id(), border_program_.id(), map_program_.id()}) {
-    if (p == map_program_.id() && !new_map) continue;
-    set_uniform(p, "u_texture_scale", scale[0], scale[1]);
-    set_uniform(p, "u_texture_offset", offset[0], offset[1]);
-    set_uniform_int(p, "u_cut_outside", cut_outside ? 1 : 0);
-    set_uniform(p, "u_region_origin", f(target.x), f(target.y));
-    set_uniform(p, "u_panel", f(m.panel[0]), f(m.panel[1]));
-    set_uniform(p, "u_pixel_pitch", f(m.pixel_pitch_mm.x), f(m.pixel_pitch_mm.y));
-    set_uniform(p, "u_shift", f(m.shift_px.x), f(m.shift_px.y));
-    set_uniform(p, "u_rotation", f(m.rotation_cos), f(m.rotation_sin));
-    set_uniform_int(p, "u_has_lens_array", m.has_lens_array ? 1 : 0);
-    if (m.has_lens_array) {
-      set_uniform(p, "u_to_lens_plane", f(m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm)));
-      set_uniform(p, "u_lattice_offset", f(m.lattice_offset_mm.x), f(m.lattice_offset_mm.y));
-      set_uniform(p, "u_lens_pitch", f(m.lens_pitch_mm));
-      set_uniform_int(p, "u_first_lens", m.first_lens[0], m.first_lens[1]);
-      set_uniform_int(p, "u_lenses", m.lenses[0], m.lenses[1]);
-      set_uniform(p, "u_chief_ray_scale", f((m.render_distance_mm - m.eye_relief_mm) / m.gap_mm));
-      set_uniform(p, "u_screen_centre", f(m.screen_centre_mm.x), f(m.screen_centre_mm.y));
-      set_uniform(p, "u_screen_size", f(m.screen_size_mm.x), f(m.screen_size_mm.y));
-    } else {
-      set_uniform(p, "u_view_size", f(m.view_size_mm.x), f(m.view_size_mm.y));
-    }
-  }
+  for (const GLuint p : {elemental_program_.id(), border_program_.id()})
+    set_mapping_uniforms(p, m, texture, target.x, target.y);
   glBindVertexArray(empty_vertex_array_.id());
   CoordinateMap& map = coordinate_maps_[e];
   if (new_map) {
-    map.fbo.reset();
-    map.texture = gl::make_texture_2d(GL_RG32F, m.panel[0], m.panel[1]);
-    map.fbo = gl::make_framebuffer(map.texture);
-    set_uniform(map_program_.id(), "u_region_origin", 0.f, 0.f);
-    glBindFramebuffer(GL_FRAMEBUFFER, map.fbo.id());
-    glViewport(0, 0, m.panel[0], m.panel[1]);
-    glUseProgram(map_program_.id());
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    draw_coordinate_map(m, texture, map);
     map.width = view.width;
     map.height = view.height;
     map.aspect = view.aspect();
@@ -272,6 +296,75 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
     glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
   }
   gl::check_error("rendering an eye image");
+}
+
+std::optional<CompositeTable> GlCompositor::make_composite_table(Eye eye, int view_width, int view_height,
+                                                                double aspect, std::array<int, 2> block) {
+  if (options_.fsaa != 1 || view_width <= 0 || view_height <= 0) return std::nullopt;
+  context_->make_current();
+  const EyeMapping m = make_eye_mapping(profile_, eye, aspect > 0.0 ? aspect : double(view_width) / view_height);
+  const PrefilterPlan plan = plan_prefilter(m, view_width, view_height, 1);
+  if (!plan.enabled || block != plan.block) return std::nullopt;
+  const TextureTransform texture = prefiltered_transform(plan);
+  const int width = m.panel[0], height = m.panel[1];
+  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+
+  CompositeTable::Recording r;
+  r.panel = m.panel;
+  r.reduced = plan.reduced;
+  r.prefiltered = plan.output;
+  const int view_size[2] = {view_width, view_height};
+  for (int axis = 0; axis < 2; ++axis)
+    (axis == 0 ? r.horizontal : r.vertical) =
+        make_box_axis(plan.output[axis], -plan.margin[axis] * plan.spacing[axis], plan.spacing[axis], plan.box[axis],
+                      plan.block[axis], plan.reduced[axis], view_size[axis]);
+
+  CoordinateMap map;
+  draw_coordinate_map(m, texture, map);
+  r.coordinates.resize(2 * pixels);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glGetTextureImage(map.texture.id(), 0, GL_RG, GL_FLOAT, static_cast<GLsizei>(r.coordinates.size() * sizeof(float)),
+                    r.coordinates.data());
+
+  if (m.has_lens_array) {
+    // The border strips write down each part's tap into four targets instead of taking them.
+    std::array<gl::Texture, 4> parts;
+    GLuint id = 0;
+    glCreateFramebuffers(1, &id);
+    gl::Framebuffer fbo(id);
+    const GLenum buffers[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
+    for (int k = 0; k < 4; ++k) {
+      parts[k] = gl::make_texture_2d(GL_RGBA32F, width, height);
+      glNamedFramebufferTexture(id, buffers[k], parts[k].id(), 0);
+    }
+    glNamedFramebufferDrawBuffers(id, 4, buffers);
+    if (glCheckNamedFramebufferStatus(id, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw gl::GlError("the border-strip recording framebuffer is incomplete");
+    const GLfloat zero[4] = {0.f, 0.f, 0.f, 0.f};
+    for (int k = 0; k < 4; ++k) glClearNamedFramebufferfv(id, GL_COLOR, k, zero);
+    set_mapping_uniforms(record_program_.id(), m, texture, 0, 0);
+    glBindVertexArray(empty_vertex_array_.id());
+    glBindFramebuffer(GL_FRAMEBUFFER, id);
+    glViewport(0, 0, width, height);
+    glUseProgram(record_program_.id());
+    glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
+    std::vector<float> part(4 * pixels);
+    r.border_parts.resize(16 * pixels);
+    for (int k = 0; k < 4; ++k) {
+      glGetTextureImage(parts[k].id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(part.size() * sizeof(float)),
+                        part.data());
+      for (std::size_t i = 0; i < pixels; ++i) std::memcpy(&r.border_parts[16 * i + 4 * k], &part[4 * i], 16);
+    }
+  }
+  gl::check_error("recording the composite table");
+  return CompositeTable(r);
+}
+
+bool prefer_composite_table(const gl::Context& context) {
+  const char* choice = std::getenv("NELF_COMPOSITE");
+  if (choice && std::string_view(choice) == "gl") return false;
+  if (choice && std::string_view(choice) == "table") return true;
+  return context.is_software();
 }
 
 EyeImages GlCompositor::compose(const StereoPair& views) {

@@ -18,7 +18,9 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 
+#include "compositor/composite_table.hpp"
 #include "compositor/compositor.hpp"
 #include "compositor/gl/context.hpp"
 #include "compositor/gl/egl_context.hpp"
@@ -101,6 +103,14 @@ class GlCompositor final : public Compositor {
   // (else std::invalid_argument).
   void render_eye_reduced(Eye eye, const GlReducedView& view, const GlTarget& target);
 
+  // The fsaa-1 composite of `eye` for views of view_width×view_height shown at `aspect` (0 =
+  // width / height), reduced by `block`, as a table for the CPU (compositor/composite_table.hpp),
+  // recorded with this compositor's shaders. Nothing where no table applies: fsaa other than 1,
+  // no prefilter, or `block` not prefilter_block() of the view. Replaying it on the CPU is much
+  // cheaper than render_eye_reduced on a software rasteriser; on a GPU render_eye_reduced wins.
+  std::optional<CompositeTable> make_composite_table(Eye eye, int view_width, int view_height, double aspect,
+                                                     std::array<int, 2> block);
+
   const gl::Context& context() const { return *context_; }
   const Profile& profile() const { return profile_; }
   const CompositorOptions& options() const { return options_; }
@@ -129,6 +139,13 @@ class GlCompositor final : public Compositor {
     int width = 0, height = 0;
   };
 
+  struct TextureTransform {
+    float scale[2] = {1.f, 1.f}, offset[2] = {0.f, 0.f};
+    bool cut_outside = true;
+  };
+  static TextureTransform prefiltered_transform(const PrefilterPlan& plan);
+  void set_mapping_uniforms(GLuint program, const EyeMapping& m, const TextureTransform& texture, int x, int y);
+  void draw_coordinate_map(const EyeMapping& m, const TextureTransform& texture, CoordinateMap& map);
   // Runs the prefilter passes; returns the texture the elemental pass samples. `reduced`: the
   // texture already holds the block means (the first pass is skipped).
   GLuint prefilter(const PrefilterPlan& plan, GLuint view_texture, int view_width, int view_height, bool reduced,
@@ -141,11 +158,17 @@ class GlCompositor final : public Compositor {
   gl::VertexArray empty_vertex_array_;
   gl::Sampler sampler_;
   gl::Program elemental_program_, border_program_, reduce_program_, box_program_, map_program_, lookup_program_;
+  gl::Program record_program_;  // fsaa 1: the border strips writing down their taps (make_composite_table)
   std::array<CoordinateMap, 2> coordinate_maps_;       // per eye, fsaa 1
   std::array<PrefilterTargets, 2> prefilter_targets_;  // per eye
   std::array<UploadedView, 2> uploads_;                // per eye, for compose()
   std::array<EyeTarget, 2> eye_targets_;               // per eye, for compose()
 };
+
+// Whether video paths should composite from a CompositeTable on the CPU rather than with GL: on a
+// software rasteriser, unless the environment says otherwise (NELF_COMPOSITE=gl or =table, for
+// comparisons and benchmarks).
+bool prefer_composite_table(const gl::Context& context);
 
 // The helpers below need a current context (e.g. GlCompositor::context().make_current()).
 // A texture holding `image` in `internal_format` (GL_RGBA16F keeps 10-bit sources' precision;

@@ -36,7 +36,9 @@ uniform vec2 u_view_size;         // mm, stock devices
 #endif
 const int u_subsamples = NELF_SUBSAMPLES;
 
+#ifndef NELF_RECORD_TAPS
 out vec4 colour;
+#endif
 
 vec2 rotate(vec2 v, float sign_) {
   const float c = u_rotation.x, s = sign_ * u_rotation.y;
@@ -88,6 +90,21 @@ vec3 point_sample(vec2 pixel) {
   return through_lens(s, ivec2(floor(lattice_position(s) + 0.5)));
 }
 
+#ifdef NELF_RECORD_TAPS
+// Where each part of a border pixel taps u_view and with what weight (x, y, weight, 1), instead of
+// tapping: the CPU composite table (compositor/composite_table.hpp) replays them every frame.
+// Part 0 is the own lens, 1 the neighbour across x, 2 across y, 3 the diagonal one; weight 0 for a
+// part that is absent or falls on a black lens.
+vec4 recorded[4] = vec4[4](vec4(0.0, 0.0, 0.0, 1.0), vec4(0.0, 0.0, 0.0, 1.0), vec4(0.0, 0.0, 0.0, 1.0),
+                           vec4(0.0, 0.0, 0.0, 1.0));
+void add_part(inout vec3 sum, int part, float weight, vec2 s, ivec2 lens) {
+  vec2 uv;
+  if (lens_coordinate(s, lens, uv)) recorded[part] = vec4(uv * u_texture_scale + u_texture_offset, weight, 1.0);
+}
+#else
+void add_part(inout vec3 sum, int part, float weight, vec2 s, ivec2 lens) { sum += weight * through_lens(s, lens); }
+#endif
+
 // One tap per lens that an `aperture`×`aperture` pixel square centred on `pixel` overlaps: a
 // (sub-)pixel straddling an elemental image border mixes both sides by area, as the reference's
 // sub-samples do; each part is tapped at its centroid. Interior ones (almost all) take one tap. Exact for an unrotated lattice;
@@ -107,28 +124,38 @@ vec3 area_sample(vec2 pixel, float aperture) {
   const vec2 own_weight = (own_hi - own_lo) / (hi - lo);
   const vec2 own_centre = 0.5 * (own_lo + own_hi);
   const vec2 other_centre = mix(0.5 * (border + hi), 0.5 * (lo + border), lessThan(step_, vec2(0.0)));
-  vec3 sum = own_weight.x * own_weight.y *
-             through_lens(s + rotate((own_centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane, ivec2(own));
+  vec3 sum = vec3(0.0);
+  add_part(sum, 0, own_weight.x * own_weight.y, s + rotate((own_centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane,
+           ivec2(own));
   if (step_.x != 0.0) {
     const vec2 centre = vec2(other_centre.x, own_centre.y);
-    sum +=
-        (1.0 - own_weight.x) * own_weight.y *
-        through_lens(s + rotate((centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane, ivec2(own + vec2(step_.x, 0.0)));
+    add_part(sum, 1, (1.0 - own_weight.x) * own_weight.y,
+             s + rotate((centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane, ivec2(own + vec2(step_.x, 0.0)));
   }
   if (step_.y != 0.0) {
     const vec2 centre = vec2(own_centre.x, other_centre.y);
-    sum +=
-        own_weight.x * (1.0 - own_weight.y) *
-        through_lens(s + rotate((centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane, ivec2(own + vec2(0.0, step_.y)));
+    add_part(sum, 2, own_weight.x * (1.0 - own_weight.y),
+             s + rotate((centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane, ivec2(own + vec2(0.0, step_.y)));
   }
   if (step_.x != 0.0 && step_.y != 0.0) {
-    sum += (1.0 - own_weight.x) * (1.0 - own_weight.y) *
-           through_lens(s + rotate((other_centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane, ivec2(own + step_));
+    add_part(sum, 3, (1.0 - own_weight.x) * (1.0 - own_weight.y),
+             s + rotate((other_centre - q) * u_lens_pitch, 1.0) / u_to_lens_plane, ivec2(own + step_));
   }
   return sum;
 }
 
-#ifdef NELF_COORDINATE_MAP
+#if defined(NELF_RECORD_TAPS)
+// The border strips' parts for the CPU composite table (one sub-sample per pixel): four targets,
+// one per part; alpha 1 marks the pixels the strips cover (cleared to 0).
+layout(location = 0) out vec4 part0;
+layout(location = 1) out vec4 part1;
+layout(location = 2) out vec4 part2;
+layout(location = 3) out vec4 part3;
+void main() {
+  area_sample(floor(gl_FragCoord.xy - u_region_origin) + 0.5, 1.0);
+  part0 = recorded[0], part1 = recorded[1], part2 = recorded[2], part3 = recorded[3];
+}
+#elif defined(NELF_COORDINATE_MAP)
 // The coordinate map (one sub-sample per pixel, prefiltered view): for each pixel, where pass 1
 // would tap u_view (RG), or -1 where the display is black (the prefiltered texture's clamped edge
 // is black). elemental_lookup.frag then only taps: the mapping above is the same every frame,

@@ -1,0 +1,88 @@
+#pragma once
+// The fsaa-1 composite of one eye as a fixed table, replayed on the CPU.
+//
+// At fsaa 1 an eye image is a fixed linear function of the view's block means: the prefilter's
+// separable box pass, then per pixel one bilinear tap of the prefiltered view through the
+// coordinate map, and along the elemental-image borders up to four area-weighted taps. Only the
+// view changes from frame to frame. On a software rasteriser (llvmpipe) every GL pass pays a large
+// per-pixel overhead (~20 ns per pixel for a one-tap pass on the 2-core reference machine), so the
+// same work done from a table on the CPU is several times cheaper. The table is recorded by the
+// GL compositor's own shaders (GlCompositor::make_composite_table: the coordinate map, and the
+// border strips writing down their taps instead of taking them), so the geometry has one source;
+// this class only replays the box pass and the taps, with the arithmetic of GL's RGBA8 path
+// (8-bit intermediates, 8-bit bilinear weights). It agrees with the GL path to within a code value
+// or two (tests/gl/test_composite_table.cpp).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace nelf {
+
+// One axis of the prefilter's separable box pass (shaders/prefilter_box.frag): for each output
+// sample, the input cells it overlaps and their weights (overlap / box width).
+struct BoxAxis {
+  std::vector<int> first;       // first input cell, per output sample
+  std::vector<int> begin;       // index into `weights` per output sample, plus one past the end
+  std::vector<float> weights;   // per overlapped cell, in order from `first`
+};
+
+// prefilter_box.frag's weights for `outputs` samples spaced `spacing` view texels apart, the first
+// sample's edge at `origin` (≤ 0), a box of `box` texels, input cells of `cell` texels, `cells` of
+// them, a view `extent` texels long (black beyond it).
+BoxAxis make_box_axis(int outputs, double origin, double spacing, double box, double cell, int cells, double extent);
+
+class CompositeTable {
+ public:
+  // What GlCompositor::make_composite_table recorded for one eye.
+  struct Recording {
+    std::array<int, 2> panel{0, 0};         // eye image size
+    std::array<int, 2> reduced{0, 0};       // size of the block-mean image render() takes
+    std::array<int, 2> prefiltered{0, 0};   // size of the box pass's output (margins included)
+    BoxAxis horizontal, vertical;           // the box pass, per axis
+    std::vector<float> coordinates;         // panel[0]·panel[1]·2: pass 1's texture coordinate, < 0 black
+    // Empty (no lens array), or panel[0]·panel[1]·16: per pixel four parts (x, y, weight, covered);
+    // covered = 1 on the pixels the border strips redraw.
+    std::vector<float> border_parts;
+  };
+
+  explicit CompositeTable(const Recording& recording);
+
+  std::array<int, 2> panel() const { return panel_; }
+  // The block-mean image render() takes (GlReducedView's texture size).
+  std::array<int, 2> reduced_size() const { return reduced_; }
+
+  // Renders the eye from `reduced` (RGBA8 block means, row 0 the top row, `reduced_stride` bytes
+  // per row) into `out` (the panel-sized eye image, RGBA8, row 0 the top row, `out_stride` bytes
+  // per row; alpha 255). Not thread-safe on one table (scratch buffers); use one per thread.
+  void render(const std::uint8_t* reduced, std::size_t reduced_stride, std::uint8_t* out, std::size_t out_stride);
+
+ private:
+  // One bilinear tap of the prefiltered image: its top-left texel (or -1 for black), the step to
+  // the right and down neighbours (0 where clamped at the edge), 8-bit fractions.
+  struct Tap {
+    std::int32_t texel = -1;
+    std::uint8_t fx = 0, fy = 0;
+    std::uint8_t right = 0;  // 0 or 1 texel
+    std::uint8_t down = 0;   // 0 or 1 row
+  };
+  struct BorderPixel {
+    std::int32_t pixel = 0;  // y · panel[0] + x
+    std::array<Tap, 4> taps;
+    std::array<float, 4> weights{};
+  };
+
+  Tap make_tap(float x, float y) const;
+  static void filter(const std::uint8_t* image, std::size_t image_row, const Tap& tap, unsigned out[3]);
+  void box_pass();
+
+  std::array<int, 2> panel_, reduced_, prefiltered_;
+  BoxAxis horizontal_, vertical_;
+  std::vector<Tap> taps_;              // per pixel, pass 1
+  std::vector<BorderPixel> borders_;   // pass 2
+  std::vector<std::uint8_t> input_;    // the block means, packed
+  std::vector<std::uint8_t> across_;   // after the horizontal box pass: prefiltered[0] × reduced[1]
+  std::vector<std::uint8_t> image_;    // the prefiltered image: prefiltered[0] × prefiltered[1], RGBA8
+};
+
+}  // namespace nelf

@@ -1,0 +1,142 @@
+// The CPU composite table (compositor/composite_table.hpp) against the GL path it replays:
+// render_eye_reduced from the same RGBA8 block means into an RGBA8 target, read back as bytes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <vector>
+
+#include "compositor/gl_compositor.hpp"
+#include "gl/gl_test_support.hpp"
+
+namespace nelf {
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+// `view` (width×height) averaged in `block` cells, RGBA8, as swscale's area filter hands them over.
+Bytes block_means(const Image& view, std::array<int, 2> block) {
+  const int w = view.width() / block[0], h = view.height() / block[1];
+  Bytes means(static_cast<std::size_t>(w) * h * 4);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 4; ++c) {
+        double sum = 0.0;
+        for (int j = 0; j < block[1]; ++j)
+          for (int i = 0; i < block[0]; ++i)
+            sum += view.data()[(static_cast<std::size_t>(y * block[1] + j) * view.width() + x * block[0] + i) * 4 + c];
+        means[(static_cast<std::size_t>(y) * w + x) * 4 + c] =
+            static_cast<std::uint8_t>(std::lround(std::clamp(sum / (block[0] * block[1]), 0.0, 1.0) * 255.0));
+      }
+  return means;
+}
+
+struct Comparison {
+  int max_difference = 0;
+  double mean_difference = 0.0;
+  double differing = 0.0;  // fraction of channel values that differ by more than 1
+  double lit = 0.0;        // mean value of the GL image (0-255)
+};
+
+// Both paths for `eye` of `profile` from a photo chart of view_w×view_h shown at `aspect`.
+Comparison compare_paths(const Profile& profile, Eye eye, int view_w, int view_h, double aspect) {
+  const auto context = test::shared_gl_context();
+  const CompositorOptions options{1, std::nullopt};
+  const auto block = prefilter_block(profile, options, eye, view_w, view_h, aspect);
+  EXPECT_EQ(view_w % block[0], 0);
+  EXPECT_EQ(view_h % block[1], 0);
+  const Bytes means = block_means(test::photo_chart(view_w, view_h), block);
+  const int mw = view_w / block[0], mh = view_h / block[1];
+  GlCompositor compositor(profile, options, context);
+  const auto panel = compositor.panel();
+
+  const gl::Texture reduced = gl::make_texture_2d(GL_RGBA8, mw, mh);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTextureSubImage2D(reduced.id(), 0, 0, 0, mw, mh, GL_RGBA, GL_UNSIGNED_BYTE, means.data());
+  // The eye at (3, 5) of a larger target, as in the packed frame.
+  const gl::Texture target = gl::make_texture_2d(GL_RGBA8, panel[0] + 7, panel[1] + 9);
+  const gl::Framebuffer fbo = gl::make_framebuffer(target);
+  compositor.render_eye_reduced(eye, {{reduced.id(), view_w, view_h, aspect}, block}, {fbo.id(), 3, 5});
+  Bytes from_gl(static_cast<std::size_t>(panel[0]) * panel[1] * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(3, 5, panel[0], panel[1], GL_RGBA, GL_UNSIGNED_BYTE, from_gl.data());
+
+  auto table = compositor.make_composite_table(eye, view_w, view_h, aspect, block);
+  EXPECT_TRUE(table);
+  if (!table) return {};
+  EXPECT_EQ(table->panel(), panel);
+  EXPECT_EQ(table->reduced_size(), (std::array<int, 2>{mw, mh}));
+  // Strides with padding on both sides, as in a packed frame.
+  const std::size_t out_stride = static_cast<std::size_t>(panel[0] + 5) * 4;
+  Bytes from_table(out_stride * panel[1], 77);
+  const std::size_t in_stride = static_cast<std::size_t>(mw) * 4 + 12;
+  Bytes padded(in_stride * mh, 0);
+  for (int y = 0; y < mh; ++y)
+    std::copy_n(&means[static_cast<std::size_t>(y) * mw * 4], mw * 4, &padded[static_cast<std::size_t>(y) * in_stride]);
+  table->render(padded.data(), in_stride, from_table.data(), out_stride);
+
+  Comparison c;
+  long long total = 0, differing = 0, lit = 0, count = 0;
+  for (int y = 0; y < panel[1]; ++y)
+    for (int x = 0; x < panel[0]; ++x)
+      for (int ch = 0; ch < 4; ++ch) {
+        const int a = from_gl[(static_cast<std::size_t>(y) * panel[0] + x) * 4 + ch];
+        const int b = from_table[y * out_stride + static_cast<std::size_t>(x) * 4 + ch];
+        const int d = std::abs(a - b);
+        c.max_difference = std::max(c.max_difference, d);
+        total += d, differing += d > 1, lit += ch < 3 ? a : 0, ++count;
+      }
+  // The padding beyond the eye's columns is untouched.
+  for (int y = 0; y < panel[1]; ++y) EXPECT_EQ(from_table[y * out_stride + panel[0] * 4], 77);
+  c.mean_difference = static_cast<double>(total) / count;
+  c.differing = static_cast<double>(differing) / count;
+  c.lit = static_cast<double>(lit) / (count * 3.0 / 4.0);
+  std::printf("table against GL: max %d, mean %.4f, %.4f %% differ by more than 1, GL mean %.1f\n", c.max_difference,
+              c.mean_difference, 100.0 * c.differing, c.lit);
+  return c;
+}
+
+void expect_same(const Comparison& c) {
+  EXPECT_GT(c.lit, 20.0);  // there is a picture to compare
+  EXPECT_LE(c.max_difference, 3);
+  EXPECT_LT(c.mean_difference, 0.1);
+  EXPECT_LT(c.differing, 0.002);
+}
+
+TEST(CompositeTable, SmallPanelMatchesTheGlPath) {
+  expect_same(compare_paths(test::small_panel_profile(), Eye::left, 480, 272, 0.0));
+}
+
+TEST(CompositeTable, HmzT1HalfSideBySideViewsMatchTheGlPathForBothEyes) {
+  const Profile profile = load_profile("hmz-t1");
+  for (Eye eye : {Eye::left, Eye::right}) expect_same(compare_paths(profile, eye, 960, 1080, 16.0 / 9.0));
+}
+
+TEST(CompositeTable, RotatedAndShiftedCalibrationMatchesTheGlPath) {
+  Profile profile = test::small_panel_profile();
+  profile.calibration[0].rotation_deg = 1.5;
+  profile.calibration[0].shift_px = {2.5, -1.25};
+  profile.calibration[0].pitch_scale = 1.01;
+  expect_same(compare_paths(profile, Eye::left, 480, 272, 0.0));
+}
+
+TEST(CompositeTable, StockDeviceWithoutLensArrayMatchesTheGlPath) {
+  expect_same(compare_paths(load_profile("hmz-t1-stock"), Eye::right, 1920, 1080, 0.0));
+}
+
+TEST(CompositeTable, OnlyForFsaa1AndThePrefiltersBlock) {
+  const auto context = test::shared_gl_context();
+  const Profile profile = test::small_panel_profile();
+  const auto block = prefilter_block(profile, {1, std::nullopt}, Eye::left, 480, 272, 0.0);
+  EXPECT_TRUE(GlCompositor(profile, {1, std::nullopt}, context).make_composite_table(Eye::left, 480, 272, 0.0, block));
+  EXPECT_FALSE(
+      GlCompositor(profile, {1, std::nullopt}, context).make_composite_table(Eye::left, 480, 272, 0.0, {8, 8}));
+  for (int fsaa : {0, 4, 16})
+    EXPECT_FALSE(
+        GlCompositor(profile, {fsaa, std::nullopt}, context).make_composite_table(Eye::left, 480, 272, 0.0, block));
+}
+
+}  // namespace
+}  // namespace nelf
