@@ -5,26 +5,89 @@
 #include <cstring>
 #include <stdexcept>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace nelf {
 
 namespace {
 
-std::uint8_t to_unorm8(float value) {
-  // GL's float → unorm8 conversion: clamp, scale by 255, round to nearest.
-  return static_cast<std::uint8_t>(std::clamp(value, 0.f, 255.f) + 0.5f);
+// GCC/Clang vector extensions: a pixel's four channels in one register, portable C++ otherwise.
+using U8x4 = std::uint8_t __attribute__((vector_size(4)));
+using U8x8 = std::uint8_t __attribute__((vector_size(8)));
+using U16x4 = std::uint16_t __attribute__((vector_size(8)));
+using U16x8 = std::uint16_t __attribute__((vector_size(16)));
+using F32x4 = float __attribute__((vector_size(16)));
+using I32x4 = std::int32_t __attribute__((vector_size(16)));
+
+F32x4 load_float4(const float* p) {
+  F32x4 v;
+  std::memcpy(&v, p, 16);
+  return v;
+}
+F32x4 clamp_unorm8(F32x4 value) {
+  const F32x4 zero = {0.f, 0.f, 0.f, 0.f}, top = {255.f, 255.f, 255.f, 255.f};
+  value = value < zero ? zero : value;
+  return value > top ? top : value;
+}
+// GL's float → unorm8 conversion of a sum of weighted 0-255 values, alpha 255.
+void store_unorm8(std::uint8_t* out, F32x4 value) {
+  U8x4 bytes = __builtin_convertvector(clamp_unorm8(value) + 0.5f, U8x4);
+  bytes[3] = 255;
+  std::memcpy(out, &bytes, 4);
+}
+
+
+// The bilinear tap at `p`: the 2×2 texels p, p + 1 texel, p + 1 row, p + 1 row + 1 texel (a row is
+// `row` bytes) weighted by `weights` (out of 256, summing to 256); the four channels times 256.
+// Every tap reads all four texels (clamped taps weight the repeats 0, black pixels point at a
+// black texel, and the image has spare rows), so there are no branches here.
+inline __attribute__((always_inline)) U16x4 bilinear(const std::uint8_t* p, std::size_t row, const U16x4 weights) {
+  U8x8 upper_texels, lower_texels;
+  std::memcpy(&upper_texels, p, 8);
+  std::memcpy(&lower_texels, p + row, 8);
+  const U16x8 upper_weights = __builtin_shufflevector(weights, weights, 0, 0, 0, 0, 1, 1, 1, 1);
+  const U16x8 lower_weights = __builtin_shufflevector(weights, weights, 2, 2, 2, 2, 3, 3, 3, 3);
+  // Each lane ≤ 255 · its weight, so the sum of all four stays ≤ 255 · 256.
+  const U16x8 sum =
+      __builtin_convertvector(upper_texels, U16x8) * upper_weights + __builtin_convertvector(lower_texels, U16x8) * lower_weights;
+  return __builtin_shufflevector(sum, sum, 0, 1, 2, 3) + __builtin_shufflevector(sum, sum, 4, 5, 6, 7);
 }
 
 }  // namespace
 
-// The three colour channels of `tap` on `image` (rows `image_row` bytes apart), times 65536.
-inline void CompositeTable::filter(const std::uint8_t* image, std::size_t image_row, const Tap& tap,
-                                   unsigned out[3]) {
-  const std::uint8_t* p = image + 4 * static_cast<std::size_t>(tap.texel);
-  const std::uint8_t* q = p + 4 * tap.right;
-  const std::uint8_t* r = p + tap.down * image_row;
-  const std::uint8_t* s = r + 4 * tap.right;
-  const unsigned fx = tap.fx, fy = tap.fy, gx = 256 - fx, gy = 256 - fy;
-  for (int c = 0; c < 3; ++c) out[c] = (p[c] * gx + q[c] * fx) * gy + (r[c] * gx + s[c] * fx) * fy;
+// Pass 1 for one row of `count` pixels. The hot loop of the CPU path: with SSE2 two pixels per
+// iteration (GCC's generic vector code for the shuffles is ~3× longer), else bilinear().
+void CompositeTable::replay_taps(const Tap* taps, int count, const std::uint8_t* image, std::size_t image_row,
+                                 std::uint8_t* out) {
+  int x = 0;
+#if defined(__SSE2__)
+  const __m128i zero = _mm_setzero_si128(), round = _mm_set1_epi16(128);
+  const auto tap_sum = [&](const Tap& tap) {
+    const __m128i w = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(tap.weights));
+    const __m128i upper_weights = _mm_unpacklo_epi64(_mm_shufflelo_epi16(w, 0x00), _mm_shufflelo_epi16(w, 0x55));
+    const __m128i lower_weights = _mm_unpacklo_epi64(_mm_shufflelo_epi16(w, 0xaa), _mm_shufflelo_epi16(w, 0xff));
+    const std::uint8_t* p = image + 4 * static_cast<std::size_t>(tap.texel);
+    const __m128i upper = _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)), zero);
+    const __m128i lower = _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p + image_row)), zero);
+    return _mm_add_epi16(_mm_mullo_epi16(upper, upper_weights), _mm_mullo_epi16(lower, lower_weights));
+  };
+  for (; x + 2 <= count; x += 2) {
+    const __m128i a = tap_sum(taps[x]), b = tap_sum(taps[x + 1]);
+    // [a's left + right texel pairs | b's], rounded, to bytes.
+    const __m128i both = _mm_add_epi16(_mm_unpacklo_epi64(a, b), _mm_unpackhi_epi64(a, b));
+    const __m128i pixels = _mm_srli_epi16(_mm_add_epi16(both, round), 8);
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(out + 4 * x), _mm_packus_epi16(pixels, pixels));
+  }
+#endif
+  for (; x < count; ++x) {
+    U16x4 weights;
+    std::memcpy(&weights, taps[x].weights, 8);
+    const U16x4 sum = bilinear(image + 4 * static_cast<std::size_t>(taps[x].texel), image_row, weights);
+    const U8x4 pixel = __builtin_convertvector((sum + 128) >> 8, U8x4);
+    std::memcpy(out + 4 * x, &pixel, 4);
+  }
 }
 
 BoxAxis make_box_axis(int outputs, double origin, double spacing, double box, double cell, int cells, double extent) {
@@ -74,106 +137,107 @@ CompositeTable::CompositeTable(const Recording& r)
   }
   input_.resize(static_cast<std::size_t>(reduced_[0]) * reduced_[1] * 4);
   across_.resize(static_cast<std::size_t>(prefiltered_[0]) * reduced_[1] * 4);
-  image_.resize(static_cast<std::size_t>(prefiltered_[0]) * prefiltered_[1] * 4);
+  // Two spare rows of opaque black: the black texel black pixels point at (the first spare row's
+  // first texel), and room for bilinear() to read 2×2 texels from any tap.
+  image_.resize(static_cast<std::size_t>(prefiltered_[0]) * (prefiltered_[1] + 2) * 4);
+  for (std::size_t i = static_cast<std::size_t>(prefiltered_[0]) * prefiltered_[1] * 4; i < image_.size(); i += 4)
+    image_[i] = image_[i + 1] = image_[i + 2] = 0, image_[i + 3] = 255;
 }
 
 CompositeTable::Tap CompositeTable::make_tap(float u, float v) const {
   Tap tap;
-  if (u < 0.f || v < 0.f) return tap;  // the map's "black"
+  tap.texel = prefiltered_[0] * prefiltered_[1];  // the black texel
+  tap.weights[0] = 256;
+  if (u < 0.f || v < 0.f) return tap;  // the map's "black": the black texel
   // GL_LINEAR with GL_CLAMP_TO_EDGE: texel centres at (i + ½) / size; each of the four texels
   // clamped into the texture on its own.
   const double size[2] = {static_cast<double>(prefiltered_[0]), static_cast<double>(prefiltered_[1])};
-  int lo[2], step[2], fraction[2];
   const double coordinate[2] = {u * size[0] - 0.5, v * size[1] - 0.5};
+  int lo[2];
+  double fraction[2];
   for (int a = 0; a < 2; ++a) {
-    int i = static_cast<int>(std::floor(coordinate[a]));
-    int f = static_cast<int>(std::lround((coordinate[a] - i) * 256.0));
-    if (f == 256) ++i, f = 0;
+    const int i = static_cast<int>(std::floor(coordinate[a]));
     const int last = prefiltered_[a] - 1;
     lo[a] = std::clamp(i, 0, last);
-    step[a] = std::clamp(i + 1, 0, last) - lo[a];
-    fraction[a] = f;
+    // Clamped at the edge both texels are the same one: all the weight on the first.
+    fraction[a] = std::clamp(i + 1, 0, last) == lo[a] ? 0.0 : coordinate[a] - i;
   }
   tap.texel = lo[1] * prefiltered_[0] + lo[0];
-  tap.fx = static_cast<std::uint8_t>(fraction[0]);
-  tap.fy = static_cast<std::uint8_t>(fraction[1]);
-  tap.right = static_cast<std::uint8_t>(step[0]);
-  tap.down = static_cast<std::uint8_t>(step[1]);
+  // The four products in 8 bits, rounded so that they still sum to 256 (the largest takes the rest).
+  const double exact[4] = {(1 - fraction[0]) * (1 - fraction[1]), fraction[0] * (1 - fraction[1]),
+                           (1 - fraction[0]) * fraction[1], fraction[0] * fraction[1]};
+  int total = 0, largest = 0;
+  for (int k = 0; k < 4; ++k) {
+    tap.weights[k] = static_cast<std::uint16_t>(std::lround(exact[k] * 256.0));
+    total += tap.weights[k];
+    if (exact[k] > exact[largest]) largest = k;
+  }
+  tap.weights[largest] = static_cast<std::uint16_t>(tap.weights[largest] + 256 - total);
   return tap;
 }
 
 void CompositeTable::box_pass() {
-  // Along x: input_ (reduced) → across_ (prefiltered width, reduced height).
+  // Along x: input_ (reduced, as float) → across_ (prefiltered width, reduced height), rounded to
+  // whole codes as GL's RGBA8 intermediate holds them.
   const int in_w = reduced_[0], rows = reduced_[1], out_w = prefiltered_[0], out_h = prefiltered_[1];
   for (int y = 0; y < rows; ++y) {
-    const std::uint8_t* in = &input_[static_cast<std::size_t>(y) * in_w * 4];
-    std::uint8_t* out = &across_[static_cast<std::size_t>(y) * out_w * 4];
+    const float* in = &input_[static_cast<std::size_t>(y) * in_w * 4];
+    float* out = &across_[static_cast<std::size_t>(y) * out_w * 4];
     for (int x = 0; x < out_w; ++x) {
-      float r = 0.f, g = 0.f, b = 0.f;
-      const std::uint8_t* cell = in + 4 * horizontal_.first[x];
-      for (int k = horizontal_.begin[x]; k < horizontal_.begin[x + 1]; ++k, cell += 4) {
-        const float w = horizontal_.weights[k];
-        r += w * cell[0], g += w * cell[1], b += w * cell[2];
-      }
-      out[4 * x] = to_unorm8(r), out[4 * x + 1] = to_unorm8(g), out[4 * x + 2] = to_unorm8(b), out[4 * x + 3] = 255;
+      F32x4 sum = {0.f, 0.f, 0.f, 0.f};
+      const float* cell = in + 4 * horizontal_.first[x];
+      for (int k = horizontal_.begin[x]; k < horizontal_.begin[x + 1]; ++k, cell += 4)
+        sum += horizontal_.weights[k] * load_float4(cell);
+      const F32x4 rounded = __builtin_convertvector(__builtin_convertvector(clamp_unorm8(sum) + 0.5f, I32x4), F32x4);
+      std::memcpy(out + 4 * x, &rounded, 16);
     }
   }
   // Along y: across_ → image_, a row at a time (the weights are per output row).
-  std::vector<float> sum(static_cast<std::size_t>(out_w) * 3);
+  row_sums_.resize(static_cast<std::size_t>(out_w) * 4);
   for (int y = 0; y < out_h; ++y) {
-    std::fill(sum.begin(), sum.end(), 0.f);
+    std::fill(row_sums_.begin(), row_sums_.end(), 0.f);
+    float* sum = row_sums_.data();
     for (int k = vertical_.begin[y], i = vertical_.first[y]; k < vertical_.begin[y + 1]; ++k, ++i) {
-      const float w = vertical_.weights[k];
-      const std::uint8_t* in = &across_[static_cast<std::size_t>(i) * out_w * 4];
-      for (int x = 0; x < out_w; ++x)
-        sum[3 * x] += w * in[4 * x], sum[3 * x + 1] += w * in[4 * x + 1], sum[3 * x + 2] += w * in[4 * x + 2];
+      const F32x4 w = {vertical_.weights[k], vertical_.weights[k], vertical_.weights[k], vertical_.weights[k]};
+      const float* in = &across_[static_cast<std::size_t>(i) * out_w * 4];
+      for (int x = 0; x < 4 * out_w; x += 4) {
+        const F32x4 v = load_float4(sum + x) + w * load_float4(in + x);
+        std::memcpy(sum + x, &v, 16);
+      }
     }
     std::uint8_t* out = &image_[static_cast<std::size_t>(y) * out_w * 4];
-    for (int x = 0; x < out_w; ++x) {
-      out[4 * x] = to_unorm8(sum[3 * x]), out[4 * x + 1] = to_unorm8(sum[3 * x + 1]);
-      out[4 * x + 2] = to_unorm8(sum[3 * x + 2]), out[4 * x + 3] = 255;
-    }
+    for (int x = 0; x < out_w; ++x) store_unorm8(out + 4 * x, load_float4(sum + 4 * x));
   }
 }
 
 void CompositeTable::render(const std::uint8_t* reduced, std::size_t reduced_stride, std::uint8_t* out,
                             std::size_t out_stride) {
-  const std::size_t row_bytes = static_cast<std::size_t>(reduced_[0]) * 4;
-  for (int y = 0; y < reduced_[1]; ++y)
-    std::memcpy(&input_[y * row_bytes], reduced + static_cast<std::size_t>(y) * reduced_stride, row_bytes);
+  for (int y = 0; y < reduced_[1]; ++y) {
+    const std::uint8_t* in = reduced + static_cast<std::size_t>(y) * reduced_stride;
+    float* row = &input_[static_cast<std::size_t>(y) * reduced_[0] * 4];
+    for (int x = 0; x < 4 * reduced_[0]; ++x) row[x] = in[x];
+  }
   box_pass();
 
-  // Pass 1: one bilinear tap per pixel, 8-bit weights as llvmpipe's RGBA8 filtering.
+  // Pass 1: one bilinear tap per pixel.
   const std::uint8_t* image = image_.data();
   const std::size_t image_row = static_cast<std::size_t>(prefiltered_[0]) * 4;
   const int width = panel_[0];
-  for (int y = 0; y < panel_[1]; ++y) {
-    const Tap* tap = &taps_[static_cast<std::size_t>(y) * width];
-    std::uint8_t* o = out + static_cast<std::size_t>(y) * out_stride;
-    for (int x = 0; x < width; ++x, ++tap, o += 4) {
-      if (tap->texel < 0) {
-        o[0] = o[1] = o[2] = 0, o[3] = 255;
-        continue;
-      }
-      unsigned v[3];
-      filter(image, image_row, *tap, v);
-      for (int c = 0; c < 3; ++c) o[c] = static_cast<std::uint8_t>((v[c] + 32768) >> 16);
-      o[3] = 255;
-    }
-  }
+  for (int y = 0; y < panel_[1]; ++y)
+    replay_taps(&taps_[static_cast<std::size_t>(y) * width], width, image, image_row,
+                out + static_cast<std::size_t>(y) * out_stride);
 
   // Pass 2: the pixels along the elemental-image borders, each part of the aperture through its lens.
   for (const BorderPixel& b : borders_) {
-    float sum[3] = {0.f, 0.f, 0.f};
+    F32x4 sum = {0.f, 0.f, 0.f, 0.f};
     for (int k = 0; k < 4; ++k) {
-      const Tap& tap = b.taps[k];
-      if (b.weights[k] <= 0.f || tap.texel < 0) continue;
-      unsigned v[3];
-      filter(image, image_row, tap, v);
-      for (int c = 0; c < 3; ++c) sum[c] += b.weights[k] * static_cast<float>(v[c]) * (1.f / 65536.f);
+      if (b.weights[k] <= 0.f) continue;
+      U16x4 weights;
+      std::memcpy(&weights, b.taps[k].weights, 8);
+      const U16x4 v = bilinear(image + 4 * static_cast<std::size_t>(b.taps[k].texel), image_row, weights);
+      sum += (b.weights[k] / 256.f) * __builtin_convertvector(v, F32x4);
     }
-    std::uint8_t* o = out + static_cast<std::size_t>(b.pixel / width) * out_stride + 4 * (b.pixel % width);
-    o[0] = to_unorm8(sum[0]), o[1] = to_unorm8(sum[1]), o[2] = to_unorm8(sum[2]), o[3] = 255;
+    store_unorm8(out + static_cast<std::size_t>(b.pixel / width) * out_stride + 4 * (b.pixel % width), sum);
   }
 }
 

@@ -58,13 +58,12 @@ class CompositeTable {
   void render(const std::uint8_t* reduced, std::size_t reduced_stride, std::uint8_t* out, std::size_t out_stride);
 
  private:
-  // One bilinear tap of the prefiltered image: its top-left texel (or -1 for black), the step to
-  // the right and down neighbours (0 where clamped at the edge), 8-bit fractions.
+  // One bilinear tap of the prefiltered image: its top-left texel and the weights (out of 256,
+  // summing to 256) of it, its right neighbour and the two below them. Black is a tap of the black
+  // texel past the image's end.
   struct Tap {
-    std::int32_t texel = -1;
-    std::uint8_t fx = 0, fy = 0;
-    std::uint8_t right = 0;  // 0 or 1 texel
-    std::uint8_t down = 0;   // 0 or 1 row
+    std::int32_t texel = 0;
+    std::uint16_t weights[4] = {0, 0, 0, 0};
   };
   struct BorderPixel {
     std::int32_t pixel = 0;  // y · panel[0] + x
@@ -73,16 +72,18 @@ class CompositeTable {
   };
 
   Tap make_tap(float x, float y) const;
-  static void filter(const std::uint8_t* image, std::size_t image_row, const Tap& tap, unsigned out[3]);
+  static void replay_taps(const Tap* taps, int count, const std::uint8_t* image, std::size_t image_row,
+                          std::uint8_t* out);
   void box_pass();
 
   std::array<int, 2> panel_, reduced_, prefiltered_;
   BoxAxis horizontal_, vertical_;
   std::vector<Tap> taps_;              // per pixel, pass 1
   std::vector<BorderPixel> borders_;   // pass 2
-  std::vector<std::uint8_t> input_;    // the block means, packed
-  std::vector<std::uint8_t> across_;   // after the horizontal box pass: prefiltered[0] × reduced[1]
+  std::vector<float> input_;           // the block means, RGBA as float
+  std::vector<float> across_;          // after the horizontal box pass: prefiltered[0] × reduced[1], RGBA
   std::vector<std::uint8_t> image_;    // the prefiltered image: prefiltered[0] × prefiltered[1], RGBA8
+  std::vector<float> row_sums_;        // the vertical box pass's accumulators, RGBA per column
 };
 
 }  // namespace nelf
