@@ -118,20 +118,20 @@ CompositeTable::CompositeTable(const Recording& r)
       horizontal_(r.horizontal),
       vertical_(r.vertical) {
   const std::size_t pixels = static_cast<std::size_t>(panel_[0]) * panel_[1];
-  if (r.coordinates.size() != 2 * pixels || (!r.border_parts.empty() && r.border_parts.size() != 16 * pixels) ||
+  if (r.coordinates.size() != 2 * pixels || r.border_parts.size() != r.border_pixels.size() ||
       horizontal_.first.size() != static_cast<std::size_t>(prefiltered_[0]) ||
       vertical_.first.size() != static_cast<std::size_t>(prefiltered_[1]))
     throw std::invalid_argument("CompositeTable: the recording's sizes do not match");
   taps_.resize(pixels);
   for (std::size_t i = 0; i < pixels; ++i) taps_[i] = make_tap(r.coordinates[2 * i], r.coordinates[2 * i + 1]);
-  for (std::size_t i = 0; !r.border_parts.empty() && i < pixels; ++i) {
-    const float* parts = &r.border_parts[16 * i];
-    if (parts[3] == 0.f) continue;  // not covered by a border strip
+  borders_.reserve(r.border_pixels.size());
+  for (std::size_t i = 0; i < r.border_pixels.size(); ++i) {
     BorderPixel b;
-    b.pixel = static_cast<std::int32_t>(i);
+    b.pixel = r.border_pixels[i];
     for (int k = 0; k < 4; ++k) {
-      b.weights[k] = parts[4 * k + 2];
-      if (b.weights[k] > 0.f) b.taps[k] = make_tap(parts[4 * k], parts[4 * k + 1]);
+      const BorderPart& part = r.border_parts[i][k];
+      b.weights[k] = part.weight;
+      if (part.weight > 0.f) b.taps[k] = make_tap(part.x, part.y);
     }
     borders_.push_back(b);
   }

@@ -34,6 +34,9 @@ BoxAxis make_box_axis(int outputs, double origin, double spacing, double box, do
 
 class CompositeTable {
  public:
+  struct BorderPart {
+    float x = 0.f, y = 0.f, weight = 0.f;
+  };
   // What GlCompositor::make_composite_table recorded for one eye.
   struct Recording {
     std::array<int, 2> panel{0, 0};         // eye image size
@@ -41,9 +44,10 @@ class CompositeTable {
     std::array<int, 2> prefiltered{0, 0};   // size of the box pass's output (margins included)
     BoxAxis horizontal, vertical;           // the box pass, per axis
     std::vector<float> coordinates;         // panel[0]·panel[1]·2: pass 1's texture coordinate, < 0 black
-    // Empty (no lens array), or panel[0]·panel[1]·16: per pixel four parts (x, y, weight, covered);
-    // covered = 1 on the pixels the border strips redraw.
-    std::vector<float> border_parts;
+    // The pixels the border strips redraw (y · panel[0] + x; none without a lens array), and for
+    // each its four parts: texture coordinate and weight (0: absent, or a black lens).
+    std::vector<std::int32_t> border_pixels;
+    std::vector<std::array<BorderPart, 4>> border_parts;
   };
 
   explicit CompositeTable(const Recording& recording);

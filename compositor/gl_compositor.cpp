@@ -327,33 +327,31 @@ std::optional<CompositeTable> GlCompositor::make_composite_table(Eye eye, int vi
                     r.coordinates.data());
 
   if (m.has_lens_array) {
-    // The border strips write down each part's tap into four targets instead of taking them.
-    std::array<gl::Texture, 4> parts;
-    GLuint id = 0;
-    glCreateFramebuffers(1, &id);
-    gl::Framebuffer fbo(id);
-    const GLenum buffers[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
-    for (int k = 0; k < 4; ++k) {
-      parts[k] = gl::make_texture_2d(GL_RGBA32F, width, height);
-      glNamedFramebufferTexture(id, buffers[k], parts[k].id(), 0);
-    }
-    glNamedFramebufferDrawBuffers(id, 4, buffers);
-    if (glCheckNamedFramebufferStatus(id, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      throw gl::GlError("the border-strip recording framebuffer is incomplete");
-    const GLfloat zero[4] = {0.f, 0.f, 0.f, 0.f};
-    for (int k = 0; k < 4; ++k) glClearNamedFramebufferfv(id, GL_COLOR, k, zero);
+    // The border strips write down each part's tap instead of taking it, a part per pass.
+    const gl::Texture part_texture = gl::make_texture_2d(GL_RGBA32F, width, height);
+    const gl::Framebuffer fbo = gl::make_framebuffer(part_texture);
     set_mapping_uniforms(record_program_.id(), m, texture, 0, 0);
     glBindVertexArray(empty_vertex_array_.id());
-    glBindFramebuffer(GL_FRAMEBUFFER, id);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
     glViewport(0, 0, width, height);
     glUseProgram(record_program_.id());
-    glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
     std::vector<float> part(4 * pixels);
-    r.border_parts.resize(16 * pixels);
     for (int k = 0; k < 4; ++k) {
-      glGetTextureImage(parts[k].id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(part.size() * sizeof(float)),
+      const GLfloat zero[4] = {0.f, 0.f, 0.f, 0.f};
+      glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, zero);
+      set_uniform_int(record_program_.id(), "u_part", k);
+      glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
+      glGetTextureImage(part_texture.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(part.size() * sizeof(float)),
                         part.data());
-      for (std::size_t i = 0; i < pixels; ++i) std::memcpy(&r.border_parts[16 * i + 4 * k], &part[4 * i], 16);
+      if (k == 0) {  // the covered pixels (alpha 1), the same in every pass
+        for (std::size_t i = 0; i < pixels; ++i)
+          if (part[4 * i + 3] != 0.f) r.border_pixels.push_back(static_cast<std::int32_t>(i));
+        r.border_parts.resize(r.border_pixels.size());
+      }
+      for (std::size_t b = 0; b < r.border_pixels.size(); ++b) {
+        const float* p = &part[4 * static_cast<std::size_t>(r.border_pixels[b])];
+        r.border_parts[b][k] = {p[0], p[1], p[2]};
+      }
     }
   }
   gl::check_error("recording the composite table");

@@ -61,6 +61,7 @@ class VideoEncoder {
 
  private:
   struct State;
+  static void convert_with_swscale(State& s, const PackedFrame& in);
   std::unique_ptr<State> state_;
 };
 

@@ -36,9 +36,7 @@ uniform vec2 u_view_size;         // mm, stock devices
 #endif
 const int u_subsamples = NELF_SUBSAMPLES;
 
-#ifndef NELF_RECORD_TAPS
 out vec4 colour;
-#endif
 
 vec2 rotate(vec2 v, float sign_) {
   const float c = u_rotation.x, s = sign_ * u_rotation.y;
@@ -145,15 +143,13 @@ vec3 area_sample(vec2 pixel, float aperture) {
 }
 
 #if defined(NELF_RECORD_TAPS)
-// The border strips' parts for the CPU composite table (one sub-sample per pixel): four targets,
-// one per part; alpha 1 marks the pixels the strips cover (cleared to 0).
-layout(location = 0) out vec4 part0;
-layout(location = 1) out vec4 part1;
-layout(location = 2) out vec4 part2;
-layout(location = 3) out vec4 part3;
+// The border strips' part u_part for the CPU composite table (one sub-sample per pixel); alpha 1
+// marks the pixels the strips cover (the target is cleared to 0). One part per pass keeps the
+// target a single panel-sized texture.
+uniform int u_part;
 void main() {
   area_sample(floor(gl_FragCoord.xy - u_region_origin) + 0.5, 1.0);
-  part0 = recorded[0], part1 = recorded[1], part2 = recorded[2], part3 = recorded[3];
+  colour = recorded[u_part];
 }
 #elif defined(NELF_COORDINATE_MAP)
 // The coordinate map (one sub-sample per pixel, prefiltered view): for each pixel, where pass 1
