@@ -299,25 +299,37 @@ class PackedFrameRenderer {
   // The CPU path: both eyes from their tables straight into the packed frame, black around them.
   PackedFrame render_from_tables(const StereoVideoFrame& f, BufferPool& buffers) {
     PackedFrame out{width_, height_, 8, buffers.take(static_cast<std::size_t>(width_) * height_ * 4), f.pts_s};
-    const std::uint32_t black = opaque_black();
-    std::fill_n(reinterpret_cast<std::uint32_t*>(out.rgba.data()), static_cast<std::size_t>(width_) * height_, black);
+    fill_outside_eyes(out.rgba.data());
     const std::size_t stride = static_cast<std::size_t>(width_) * 4;
     for (Eye eye : {Eye::left, Eye::right}) {
       const int e = static_cast<int>(eye);
       if (!origins_[e] || !tables_[e]) continue;
       const auto& view = eye == Eye::left ? f.left : f.right;
       const std::size_t view_stride = static_cast<std::size_t>(texture_w()) * 4;
-      tables_[e]->render(view.data(), view_stride,
-                         out.rgba.data() + origins_[e]->second * stride + static_cast<std::size_t>(origins_[e]->first) * 4,
-                         stride);
+      tables_[e]->render(
+          view.data(), view_stride,
+          out.rgba.data() + origins_[e]->second * stride + static_cast<std::size_t>(origins_[e]->first) * 4, stride);
     }
     return out;
   }
-  static std::uint32_t opaque_black() {
-    const std::uint8_t bytes[4] = {0, 0, 0, 255};
-    std::uint32_t value = 0;
-    std::memcpy(&value, bytes, 4);
-    return value;
+  // Opaque black wherever the eyes do not draw (the gap, and borders when a panel is smaller than
+  // its eye area); the eyes overwrite all of their own pixels.
+  void fill_outside_eyes(std::uint8_t* rgba) const {
+    const auto panel = compositor_.panel();
+    const std::uint8_t black[4] = {0, 0, 0, 255};
+    const auto fill = [&](int y, int from, int to) {
+      for (std::uint8_t* p = rgba + (static_cast<std::size_t>(y) * width_ + from) * 4; from < to; ++from, p += 4)
+        std::memcpy(p, black, 4);
+    };
+    for (int y = 0; y < height_; ++y) {
+      int from = 0;
+      for (const auto& origin : origins_) {
+        if (!origin || y < origin->second || y >= origin->second + panel[1]) continue;
+        fill(y, from, origin->first);
+        from = origin->first + panel[0];
+      }
+      fill(y, from, width_);
+    }
   }
 
   int texture_w() const { return view_w_ / block_[0]; }

@@ -38,7 +38,6 @@ void store_unorm8(std::uint8_t* out, F32x4 value) {
   std::memcpy(out, &bytes, 4);
 }
 
-
 // The bilinear tap at `p`: the 2×2 texels p, p + 1 texel, p + 1 row, p + 1 row + 1 texel (a row is
 // `row` bytes) weighted by `weights` (out of 256, summing to 256); the four channels times 256.
 // Every tap reads all four texels (clamped taps weight the repeats 0, black pixels point at a
@@ -50,8 +49,8 @@ inline __attribute__((always_inline)) U16x4 bilinear(const std::uint8_t* p, std:
   const U16x8 upper_weights = __builtin_shufflevector(weights, weights, 0, 0, 0, 0, 1, 1, 1, 1);
   const U16x8 lower_weights = __builtin_shufflevector(weights, weights, 2, 2, 2, 2, 3, 3, 3, 3);
   // Each lane ≤ 255 · its weight, so the sum of all four stays ≤ 255 · 256.
-  const U16x8 sum =
-      __builtin_convertvector(upper_texels, U16x8) * upper_weights + __builtin_convertvector(lower_texels, U16x8) * lower_weights;
+  const U16x8 sum = __builtin_convertvector(upper_texels, U16x8) * upper_weights +
+                    __builtin_convertvector(lower_texels, U16x8) * lower_weights;
   return __builtin_shufflevector(sum, sum, 0, 1, 2, 3) + __builtin_shufflevector(sum, sum, 4, 5, 6, 7);
 }
 

@@ -22,9 +22,9 @@ namespace nelf {
 // One axis of the prefilter's separable box pass (shaders/prefilter_box.frag): for each output
 // sample, the input cells it overlaps and their weights (overlap / box width).
 struct BoxAxis {
-  std::vector<int> first;       // first input cell, per output sample
-  std::vector<int> begin;       // index into `weights` per output sample, plus one past the end
-  std::vector<float> weights;   // per overlapped cell, in order from `first`
+  std::vector<int> first;      // first input cell, per output sample
+  std::vector<int> begin;      // index into `weights` per output sample, plus one past the end
+  std::vector<float> weights;  // per overlapped cell, in order from `first`
 };
 
 // prefilter_box.frag's weights for `outputs` samples spaced `spacing` view texels apart, the first
@@ -39,11 +39,11 @@ class CompositeTable {
   };
   // What GlCompositor::make_composite_table recorded for one eye.
   struct Recording {
-    std::array<int, 2> panel{0, 0};         // eye image size
-    std::array<int, 2> reduced{0, 0};       // size of the block-mean image render() takes
-    std::array<int, 2> prefiltered{0, 0};   // size of the box pass's output (margins included)
-    BoxAxis horizontal, vertical;           // the box pass, per axis
-    std::vector<float> coordinates;         // panel[0]·panel[1]·2: pass 1's texture coordinate, < 0 black
+    std::array<int, 2> panel{0, 0};        // eye image size
+    std::array<int, 2> reduced{0, 0};      // size of the block-mean image render() takes
+    std::array<int, 2> prefiltered{0, 0};  // size of the box pass's output (margins included)
+    BoxAxis horizontal, vertical;          // the box pass, per axis
+    std::vector<float> coordinates;        // panel[0]·panel[1]·2: pass 1's texture coordinate, < 0 black
     // The pixels the border strips redraw (y · panel[0] + x; none without a lens array), and for
     // each its four parts: texture coordinate and weight (0: absent, or a black lens).
     std::vector<std::int32_t> border_pixels;
@@ -82,12 +82,12 @@ class CompositeTable {
 
   std::array<int, 2> panel_, reduced_, prefiltered_;
   BoxAxis horizontal_, vertical_;
-  std::vector<Tap> taps_;              // per pixel, pass 1
-  std::vector<BorderPixel> borders_;   // pass 2
-  std::vector<float> input_;           // the block means, RGBA as float
-  std::vector<float> across_;          // after the horizontal box pass: prefiltered[0] × reduced[1], RGBA
-  std::vector<std::uint8_t> image_;    // the prefiltered image: prefiltered[0] × prefiltered[1], RGBA8
-  std::vector<float> row_sums_;        // the vertical box pass's accumulators, RGBA per column
+  std::vector<Tap> taps_;             // per pixel, pass 1
+  std::vector<BorderPixel> borders_;  // pass 2
+  std::vector<float> input_;          // the block means, RGBA as float
+  std::vector<float> across_;         // after the horizontal box pass: prefiltered[0] × reduced[1], RGBA
+  std::vector<std::uint8_t> image_;   // the prefiltered image: prefiltered[0] × prefiltered[1], RGBA8
+  std::vector<float> row_sums_;       // the vertical box pass's accumulators, RGBA per column
 };
 
 }  // namespace nelf

@@ -299,7 +299,7 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
 }
 
 std::optional<CompositeTable> GlCompositor::make_composite_table(Eye eye, int view_width, int view_height,
-                                                                double aspect, std::array<int, 2> block) {
+                                                                 double aspect, std::array<int, 2> block) {
   if (options_.fsaa != 1 || view_width <= 0 || view_height <= 0) return std::nullopt;
   context_->make_current();
   const EyeMapping m = make_eye_mapping(profile_, eye, aspect > 0.0 ? aspect : double(view_width) / view_height);

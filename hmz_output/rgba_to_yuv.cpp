@@ -97,8 +97,7 @@ int chroma4(__m128i blocks01, __m128i blocks23, __m128i coefficients) {
 }
 
 // Chroma samples [0, width/8·4) from rows `top` and `bottom`; returns where it stopped.
-int chroma_row_sse2(const std::uint8_t* top, const std::uint8_t* bottom, int width, std::uint8_t* u,
-                    std::uint8_t* v) {
+int chroma_row_sse2(const std::uint8_t* top, const std::uint8_t* bottom, int width, std::uint8_t* u, std::uint8_t* v) {
   const __m128i u_coefficients = _mm_setr_epi16(UR, UG, UB, 0, UR, UG, UB, 0);
   const __m128i v_coefficients = _mm_setr_epi16(VR, VG, VB, 0, VR, VG, VB, 0);
   int cx = 0;

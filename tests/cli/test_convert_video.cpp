@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 #include <string>
@@ -158,6 +159,38 @@ TEST(ConvertVideo, HmzT1FramePackedOutput) {
   EXPECT_EQ(p.video_packets, 3);
   expect_packed_eyes(dir / "out.mkv", Tint::red, Tint::blue, 1280 * 720 / 4);
   EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"clip.mkv", "out.mkv"}));
+}
+
+// On a software rasteriser nelf convert composites from a table on the CPU (compositor/
+// composite_table.hpp); NELF_COMPOSITE=gl forces the GL passes. Both give the same frames, through
+// swscale to RGB (ffv1) and through the encoder's own conversion to yuv420p (h264, lossless).
+TEST(ConvertVideo, CpuTableAndGlCompositingGiveTheSameFrames) {
+  TempDir dir;
+  make_media(dir / "detail.mkv", "-f lavfi -i testsrc2=s=960x540:r=10 -frames:v 3 -filter_complex " +
+                                     shell_quote("scale=480:540,split[a][b];[b]hue=h=120[c];[a][c]hstack") + h264);
+  for (const std::string codec : {"ffv1", "h264"}) {
+    SCOPED_TRACE(codec);
+    for (const std::string way : {"gl", "table"}) {
+      const auto r = run_command("NELF_COMPOSITE=" + way + " " + shell_quote(NELF_BINARY) + " convert " +
+                                 q(dir / "detail.mkv") + " " + q(dir / (way + "-" + codec + ".mkv")) +
+                                 " --layout sbs-half --profile hmz-t1 --quiet --codec " + codec +
+                                 (codec == "h264" ? " --crf 0" : ""));
+      ASSERT_EQ(r.status, 0) << r.err;
+    }
+    const RgbFrame gl = decode_frame(dir / ("gl-" + codec + ".mkv"), 1280, 1470, 1);
+    const RgbFrame table = decode_frame(dir / ("table-" + codec + ".mkv"), 1280, 1470, 1);
+    ASSERT_EQ(gl.bytes.size(), table.bytes.size());
+    double total = 0.0, lit = 0.0;
+    for (std::size_t i = 0; i < gl.bytes.size(); ++i) {
+      total += std::abs(int(static_cast<unsigned char>(gl.bytes[i])) - int(static_cast<unsigned char>(table.bytes[i])));
+      lit += static_cast<unsigned char>(gl.bytes[i]);
+    }
+    const double n = static_cast<double>(gl.bytes.size());
+    std::printf("%s: mean difference %.3f codes, mean level %.1f\n", codec.c_str(), total / n, lit / n);
+    EXPECT_GT(lit / n, 20.0);   // a picture, not black
+    EXPECT_LT(total / n, 0.1);  // codes: the GL and CPU paths round alike to within one code
+    EXPECT_EQ(stats(table, 0, 720, 1280, 750).max_value, 0);  // the gap stays black
+  }
 }
 
 // Every layout sends the left (red) view to the top eye and the right (blue) one to the bottom eye.
