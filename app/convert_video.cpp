@@ -20,6 +20,7 @@ extern "C" {
 
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
+#include "compositor/composite_table_cache.hpp"
 #include "compositor/gl_compositor.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
@@ -228,13 +229,9 @@ class PackedFrameRenderer {
  public:
   PackedFrameRenderer(const VideoConvertRequest& r, int view_w, int view_h, int bits, double aspect,
                       std::array<int, 2> block)
-      : compositor_(r.profile, r.compositor, std::make_shared<gl::EglContext>(gl::ContextOptions{r.compositor.gpu})),
-        signal_(r.signal),
-        view_w_(view_w),
-        view_h_(view_h),
-        bits_(bits),
-        block_(block) {
-    const auto panel = compositor_.panel();
+      : signal_(r.signal), view_w_(view_w), view_h_(view_h), bits_(bits), block_(block) {
+    validate_fsaa(r.compositor.fsaa);
+    const auto panel = panel_ = r.profile.display.resolution;
     width_ = signal_.packed_width(panel[0]);
     height_ = signal_.packed_height(panel[1]);
     for (Eye eye : {Eye::left, Eye::right}) {
@@ -250,15 +247,12 @@ class PackedFrameRenderer {
     }
     // On a software rasteriser 8-bit block means are composited on the CPU from tables recorded
     // once with the compositor's shaders (compositor/composite_table.hpp): several times cheaper
-    // than llvmpipe's passes. Everything else goes through GL.
-    if (bits == 8 && prefer_composite_table(compositor_.context())) {
-      for (Eye eye : {Eye::left, Eye::right}) {
-        if (!origins_[static_cast<int>(eye)]) continue;
-        tables_[static_cast<int>(eye)] = compositor_.make_composite_table(eye, view_w, view_h, aspect, block);
-        if (!tables_[static_cast<int>(eye)]) tables_ = {};
-        if (!tables_[static_cast<int>(eye)]) break;
-      }
-    }
+    // than llvmpipe's passes. Tables seen before come from the cache without starting GL at all.
+    const CompositeTableCache cache;
+    if (bits == 8 && tables_from_cache(r, cache, aspect)) return;
+    compositor_.emplace(r.profile, r.compositor,
+                        std::make_shared<gl::EglContext>(gl::ContextOptions{r.compositor.gpu}));
+    if (bits == 8 && prefer_composite_table(compositor_->context())) record_tables(r, cache, aspect);
     if (tables_[0] || tables_[1]) return;
     const GLenum internal = bits > 8 ? GL_RGBA16 : GL_RGBA8;
     for (auto& t : views_) t = gl::make_texture_2d(internal, texture_w(), texture_h());
@@ -282,9 +276,9 @@ class PackedFrameRenderer {
       const GlTextureView view{views_[static_cast<int>(eye)].id(), view_w_, view_h_, f.aspect};
       const GlTarget target{packed_fbo_.id(), origin->first, origin->second};
       if (block_[0] > 1 || block_[1] > 1)
-        compositor_.render_eye_reduced(eye, GlReducedView{view, block_}, target);
+        compositor_->render_eye_reduced(eye, GlReducedView{view, block_}, target);
       else
-        compositor_.render_eye(eye, view, target);
+        compositor_->render_eye(eye, view, target);
     }
     PackedFrame out{width_, height_, bits_ > 8 ? 16 : 8,
                     buffers.take(static_cast<std::size_t>(width_) * height_ * bytes_per_pixel(bits_)), f.pts_s};
@@ -296,6 +290,41 @@ class PackedFrameRenderer {
   }
 
  private:
+  // Both eyes' tables from `cache`, where the CPU path is wanted without asking GL: never on a
+  // machine that may have a GPU (a render node), unless NELF_COMPOSITE=table says so.
+  bool tables_from_cache(const VideoConvertRequest& r, const CompositeTableCache& cache, double aspect) {
+    const CompositeChoice choice = composite_choice();
+    if (choice == CompositeChoice::gl || (choice == CompositeChoice::automatic && has_render_node())) return false;
+    for (Eye eye : {Eye::left, Eye::right}) {
+      if (!origins_[static_cast<int>(eye)]) continue;
+      auto recording = cache.load(composite_table_key(r.profile, r.compositor, eye, view_w_, view_h_, aspect, block_));
+      try {
+        if (!recording || recording->panel != panel_ ||
+            recording->reduced != std::array<int, 2>{texture_w(), texture_h()})
+          throw std::invalid_argument("not cached");
+        tables_[static_cast<int>(eye)].emplace(*recording);
+      } catch (const std::invalid_argument&) {  // missing, or not a table for these views
+        tables_ = {};
+        return false;
+      }
+    }
+    return tables_[0] || tables_[1];
+  }
+  // Both eyes' tables recorded with the GL compositor (and kept in `cache`), or none when one has
+  // no table (fsaa other than 1, whole views).
+  void record_tables(const VideoConvertRequest& r, const CompositeTableCache& cache, double aspect) {
+    for (Eye eye : {Eye::left, Eye::right}) {
+      if (!origins_[static_cast<int>(eye)]) continue;
+      auto recording = compositor_->record_composite_table(eye, view_w_, view_h_, aspect, block_);
+      if (!recording) {
+        tables_ = {};
+        return;
+      }
+      cache.store(composite_table_key(r.profile, r.compositor, eye, view_w_, view_h_, aspect, block_), *recording);
+      tables_[static_cast<int>(eye)].emplace(*recording);
+    }
+  }
+
   // The CPU path: both eyes from their tables straight into the packed frame, black around them.
   PackedFrame render_from_tables(const StereoVideoFrame& f, BufferPool& buffers) {
     PackedFrame out{width_, height_, 8, buffers.take(static_cast<std::size_t>(width_) * height_ * 4), f.pts_s};
@@ -315,7 +344,7 @@ class PackedFrameRenderer {
   // Opaque black wherever the eyes do not draw (the gap, and borders when a panel is smaller than
   // its eye area); the eyes overwrite all of their own pixels.
   void fill_outside_eyes(std::uint8_t* rgba) const {
-    const auto panel = compositor_.panel();
+    const auto panel = panel_;
     const std::uint8_t black[4] = {0, 0, 0, 255};
     const auto fill = [&](int y, int from, int to) {
       for (std::uint8_t* p = rgba + (static_cast<std::size_t>(y) * width_ + from) * 4; from < to; ++from, p += 4)
@@ -335,8 +364,9 @@ class PackedFrameRenderer {
   int texture_w() const { return view_w_ / block_[0]; }
   int texture_h() const { return view_h_ / block_[1]; }
 
-  GlCompositor compositor_;
+  std::optional<GlCompositor> compositor_;  // none when the tables came from the cache
   Signal signal_;
+  std::array<int, 2> panel_{0, 0};
   int view_w_, view_h_, bits_;
   std::array<int, 2> block_;
   int width_ = 0, height_ = 0;

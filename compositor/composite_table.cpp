@@ -117,10 +117,25 @@ CompositeTable::CompositeTable(const Recording& r)
       horizontal_(r.horizontal),
       vertical_(r.vertical) {
   const std::size_t pixels = static_cast<std::size_t>(panel_[0]) * panel_[1];
-  if (r.coordinates.size() != 2 * pixels || r.border_parts.size() != r.border_pixels.size() ||
-      horizontal_.first.size() != static_cast<std::size_t>(prefiltered_[0]) ||
-      vertical_.first.size() != static_cast<std::size_t>(prefiltered_[1]))
-    throw std::invalid_argument("CompositeTable: the recording's sizes do not match");
+  // A recording may come from a cache file: everything that indexes memory is checked.
+  const auto axis_fits = [](const BoxAxis& axis, int outputs, int cells) {
+    if (axis.first.size() != static_cast<std::size_t>(outputs) || axis.begin.size() != axis.first.size() + 1 ||
+        axis.begin.front() != 0 || static_cast<std::size_t>(axis.begin.back()) != axis.weights.size())
+      return false;
+    for (int o = 0; o < outputs; ++o)
+      if (axis.begin[o + 1] < axis.begin[o] || axis.first[o] < 0 ||
+          axis.first[o] + (axis.begin[o + 1] - axis.begin[o]) > cells)
+        return false;
+    return true;
+  };
+  const bool borders_fit = std::all_of(r.border_pixels.begin(), r.border_pixels.end(), [&](std::int32_t p) {
+    return p >= 0 && static_cast<std::size_t>(p) < pixels;
+  });
+  if (panel_[0] <= 0 || panel_[1] <= 0 || reduced_[0] <= 0 || reduced_[1] <= 0 || prefiltered_[0] <= 0 ||
+      prefiltered_[1] <= 0 || r.coordinates.size() != 2 * pixels || r.border_parts.size() != r.border_pixels.size() ||
+      !borders_fit || !axis_fits(horizontal_, prefiltered_[0], reduced_[0]) ||
+      !axis_fits(vertical_, prefiltered_[1], reduced_[1]))
+    throw std::invalid_argument("CompositeTable: the recording is inconsistent");
   taps_.resize(pixels);
   for (std::size_t i = 0; i < pixels; ++i) taps_[i] = make_tap(r.coordinates[2 * i], r.coordinates[2 * i + 1]);
   borders_.reserve(r.border_pixels.size());

@@ -300,6 +300,13 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
 
 std::optional<CompositeTable> GlCompositor::make_composite_table(Eye eye, int view_width, int view_height,
                                                                  double aspect, std::array<int, 2> block) {
+  auto recording = record_composite_table(eye, view_width, view_height, aspect, block);
+  if (!recording) return std::nullopt;
+  return CompositeTable(*recording);
+}
+
+std::optional<CompositeTable::Recording> GlCompositor::record_composite_table(Eye eye, int view_width, int view_height,
+                                                                              double aspect, std::array<int, 2> block) {
   if (options_.fsaa != 1 || view_width <= 0 || view_height <= 0) return std::nullopt;
   context_->make_current();
   const EyeMapping m = make_eye_mapping(profile_, eye, aspect > 0.0 ? aspect : double(view_width) / view_height);
@@ -355,14 +362,19 @@ std::optional<CompositeTable> GlCompositor::make_composite_table(Eye eye, int vi
     }
   }
   gl::check_error("recording the composite table");
-  return CompositeTable(r);
+  return r;
+}
+
+CompositeChoice composite_choice() {
+  const char* choice = std::getenv("NELF_COMPOSITE");
+  if (choice && std::string_view(choice) == "gl") return CompositeChoice::gl;
+  if (choice && std::string_view(choice) == "table") return CompositeChoice::table;
+  return CompositeChoice::automatic;
 }
 
 bool prefer_composite_table(const gl::Context& context) {
-  const char* choice = std::getenv("NELF_COMPOSITE");
-  if (choice && std::string_view(choice) == "gl") return false;
-  if (choice && std::string_view(choice) == "table") return true;
-  return context.is_software();
+  const CompositeChoice choice = composite_choice();
+  return choice == CompositeChoice::table || (choice == CompositeChoice::automatic && context.is_software());
 }
 
 EyeImages GlCompositor::compose(const StereoPair& views) {

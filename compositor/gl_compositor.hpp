@@ -110,6 +110,9 @@ class GlCompositor final : public Compositor {
   // cheaper than render_eye_reduced on a software rasteriser; on a GPU render_eye_reduced wins.
   std::optional<CompositeTable> make_composite_table(Eye eye, int view_width, int view_height, double aspect,
                                                      std::array<int, 2> block);
+  // What make_composite_table builds the table from (e.g. to keep it in a CompositeTableCache).
+  std::optional<CompositeTable::Recording> record_composite_table(Eye eye, int view_width, int view_height,
+                                                                  double aspect, std::array<int, 2> block);
 
   const gl::Context& context() const { return *context_; }
   const Profile& profile() const { return profile_; }
@@ -169,6 +172,8 @@ class GlCompositor final : public Compositor {
 // software rasteriser, unless the environment says otherwise (NELF_COMPOSITE=gl or =table, for
 // comparisons and benchmarks).
 bool prefer_composite_table(const gl::Context& context);
+enum class CompositeChoice { automatic, gl, table };
+CompositeChoice composite_choice();  // NELF_COMPOSITE
 
 // The helpers below need a current context (e.g. GlCompositor::context().make_current()).
 // A texture holding `image` in `internal_format` (GL_RGBA16F keeps 10-bit sources' precision;

@@ -193,6 +193,31 @@ TEST(ConvertVideo, CpuTableAndGlCompositingGiveTheSameFrames) {
   }
 }
 
+// The composite tables recorded by the first conversion are kept (NELF_CACHE_DIR); a second
+// conversion of the same geometry needs no GL at all (here: no EGL vendor to load) and writes the
+// same file. Without a cache entry the missing GL is the usual one-line error.
+TEST(ConvertVideo, SecondConversionUsesTheCachedTablesWithoutGl) {
+  TempDir dir;
+  make_media(dir / "clip.mkv", red_blue(320, 180, false, 3));
+  const std::string cache = "NELF_CACHE_DIR=" + q(dir / "cache") + " ";
+  const std::string no_gl = "__EGL_VENDOR_LIBRARY_DIRS=" + q(dir / "none") + " ";
+  const auto convert = [&](const std::string& env, const std::string& out) {
+    return run_command(env + "NELF_COMPOSITE=table " + shell_quote(NELF_BINARY) + " convert " + q(dir / "clip.mkv") +
+                       " " + q(dir / out) + " --profile hmz-t1 --codec ffv1 --quiet");
+  };
+  auto r = convert(cache + no_gl, "first.mkv");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("OpenGL"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "first.mkv"));
+  r = convert(cache, "first.mkv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(files_in(dir / "cache" / "composite-tables").size(), 2u);  // one per eye
+  r = convert(cache + no_gl, "second.mkv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(decode_frame(dir / "first.mkv", 1280, 1470, 2).bytes,
+            decode_frame(dir / "second.mkv", 1280, 1470, 2).bytes);
+}
+
 // Every layout sends the left (red) view to the top eye and the right (blue) one to the bottom eye.
 TEST(ConvertVideo, EveryLayoutRoutesTheEyes) {
   TempDir dir;

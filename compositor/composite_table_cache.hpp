@@ -1,0 +1,48 @@
+#pragma once
+// Composite-table recordings kept on disk (like Mesa's shader cache), so that a conversion whose
+// optics and view geometry were seen before starts without a GL context: on a machine without a
+// GPU, loading llvmpipe and recording the tables is ~1 s of the start-up of `nelf convert`,
+// against ~0.3 s for all of ffmpeg's. An entry holds its whole key (profile, eye, view geometry,
+// shaders, nelf version) and is used only when that matches; entries are written atomically, and
+// a cache that cannot be read or written is simply not used.
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "compositor/composite_table.hpp"
+#include "compositor/compositor.hpp"
+#include "compositor/profile.hpp"
+
+namespace nelf {
+
+// $NELF_CACHE_DIR, else $XDG_CACHE_HOME/nelf, else $HOME/.cache/nelf; with /composite-tables
+// appended. Empty when none of them is set (no cache).
+std::filesystem::path default_composite_table_cache();
+
+// Everything a recording depends on, as text.
+std::string composite_table_key(const Profile& profile, const CompositorOptions& options, Eye eye, int view_width,
+                                int view_height, double aspect, std::array<int, 2> block);
+
+class CompositeTableCache {
+ public:
+  explicit CompositeTableCache(std::filesystem::path directory = default_composite_table_cache())
+      : directory_(std::move(directory)) {}
+
+  // The recording stored under `key`, if there is a readable one.
+  std::optional<CompositeTable::Recording> load(const std::string& key) const;
+  // Stores `recording` under `key`; false (and nothing left behind) when that fails.
+  bool store(const std::string& key, const CompositeTable::Recording& recording) const;
+
+  const std::filesystem::path& directory() const { return directory_; }
+
+ private:
+  std::filesystem::path path_for(const std::string& key) const;
+  std::filesystem::path directory_;
+};
+
+// True when the machine has a DRM render node (/dev/dri/renderD*): a GPU may be there, so the
+// GL context decides between GL and the CPU table rather than a cached table.
+bool has_render_node();
+
+}  // namespace nelf
