@@ -123,8 +123,8 @@ CompositeTable::CompositeTable(const Recording& r)
         axis.begin.front() != 0 || static_cast<std::size_t>(axis.begin.back()) != axis.weights.size())
       return false;
     for (int o = 0; o < outputs; ++o)
-      if (axis.begin[o + 1] < axis.begin[o] || axis.first[o] < 0 ||
-          axis.first[o] + (axis.begin[o + 1] - axis.begin[o]) > cells)
+      if (const int count = axis.begin[o + 1] - axis.begin[o];
+          count < 0 || (count > 0 && (axis.first[o] < 0 || axis.first[o] + count > cells)))
         return false;
     return true;
   };
