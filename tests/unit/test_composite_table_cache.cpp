@@ -116,3 +116,26 @@ TEST(CompositeTableCache, DefaultDirectoryFollowsTheEnvironment) {
 
 }  // namespace
 }  // namespace nelf
+
+namespace nelf {
+namespace {
+
+// A recording read from a damaged or foreign cache file must not index outside its buffers.
+TEST(CompositeTableCache, InconsistentRecordingsAreRefusedByTheTable) {
+  EXPECT_NO_THROW(CompositeTable{small_recording()});
+  auto bad = small_recording();
+  bad.horizontal.first[1] = 5;  // beyond the 2 input cells
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+  bad = small_recording();
+  bad.border_pixels[1] = 6;  // the panel has 6 pixels
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+  bad = small_recording();
+  bad.coordinates.pop_back();
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+  bad = small_recording();
+  bad.vertical.begin.back() = 99;
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace nelf
