@@ -15,22 +15,13 @@
 #include <memory>
 #include <vector>
 
+#include "bench/bench_timing.hpp"
 #include "compositor/gl_compositor.hpp"
 
 namespace {
 
-using clock_type = std::chrono::steady_clock;
-
-double elapsed_ms(const std::function<void()>& body) {
-  const auto start = clock_type::now();
-  body();
-  return std::chrono::duration<double, std::milli>(clock_type::now() - start).count();
-}
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
+using nelf::bench::elapsed_ms;
+using nelf::bench::median;
 
 }  // namespace
 

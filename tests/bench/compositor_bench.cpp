@@ -14,11 +14,13 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_timing.hpp"
 #include "compositor/gl_compositor.hpp"
 
 namespace {
 
-using clock_type = std::chrono::steady_clock;
+using nelf::bench::elapsed_ms;
+using nelf::bench::median;
 
 nelf::Image test_view(int width, int height) {
   nelf::Image image(width, height);
@@ -29,18 +31,6 @@ nelf::Image test_view(int width, int height) {
       image.at(x, y) = {v, static_cast<float>(u), static_cast<float>(t), 1.f};
     }
   return image;
-}
-
-double elapsed_ms(const std::function<void()>& body) {
-  const auto start = clock_type::now();
-  body();
-  glFinish();
-  return std::chrono::duration<double, std::milli>(clock_type::now() - start).count();
-}
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
 }
 
 }  // namespace
@@ -68,7 +58,8 @@ int main(int argc, char** argv) {
     const int levels[] = {0, 1, 4, 16};
     std::vector<std::unique_ptr<nelf::GlCompositor>> compositors;
     for (int fsaa : levels)
-      compositors.push_back(std::make_unique<nelf::GlCompositor>(profile, nelf::CompositorOptions{fsaa, std::nullopt}, context));
+      compositors.push_back(
+          std::make_unique<nelf::GlCompositor>(profile, nelf::CompositorOptions{fsaa, std::nullopt}, context));
     std::vector<std::vector<double>> render_ms(4), compose_ms(4);
     for (int run = 0; run <= runs; ++run) {
       for (std::size_t level = 0; level < compositors.size(); ++level) {
@@ -76,8 +67,12 @@ int main(int argc, char** argv) {
         const double render = elapsed_ms([&] {
           compositor.render_eye(nelf::Eye::left, {left.id(), 1920, 1080, 0.0}, {target.id(), 0, 0});
           compositor.render_eye(nelf::Eye::right, {right.id(), 1920, 1080, 0.0}, {target.id(), 0, panel[1]});
+          glFinish();
         });
-        const double compose = elapsed_ms([&] { compositor.compose(views); });
+        const double compose = elapsed_ms([&] {
+          compositor.compose(views);
+          glFinish();
+        });
         if (run > 0) render_ms[level].push_back(render), compose_ms[level].push_back(compose);
       }
     }
