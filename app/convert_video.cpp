@@ -330,15 +330,18 @@ class PackedFrameRenderer {
     PackedFrame out{width_, height_, 8, buffers.take(static_cast<std::size_t>(width_) * height_ * 4), f.pts_s};
     fill_outside_eyes(out.rgba.data());
     const std::size_t stride = static_cast<std::size_t>(width_) * 4;
-    for (Eye eye : {Eye::left, Eye::right}) {
-      const int e = static_cast<int>(eye);
-      if (!origins_[e] || !tables_[e]) continue;
-      const auto& view = eye == Eye::left ? f.left : f.right;
-      const std::size_t view_stride = static_cast<std::size_t>(texture_w()) * 4;
-      tables_[e]->render(
-          view.data(), view_stride,
-          out.rgba.data() + origins_[e]->second * stride + static_cast<std::size_t>(origins_[e]->first) * 4, stride);
-    }
+    const auto render_eye = [&](int e) {
+      if (!origins_[e] || !tables_[e]) return;
+      const auto& view = e == 0 ? f.left : f.right;
+      tables_[e]->render(view.data(), static_cast<std::size_t>(texture_w()) * 4,
+                         out.rgba.data() + origins_[e]->second * stride + static_cast<std::size_t>(origins_[e]->first) * 4,
+                         stride);
+    };
+    // The eyes in parallel: while x264 fills its look-ahead the compositing is what the pipeline
+    // waits for, and each table has its own scratch buffers.
+    auto right = std::async(std::launch::async, render_eye, 1);
+    render_eye(0);
+    right.get();
     return out;
   }
   // Opaque black wherever the eyes do not draw (the gap, and borders when a panel is smaller than
