@@ -98,22 +98,47 @@ GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shar
   context_->make_current();
   empty_vertex_array_ = gl::make_vertex_array();
   sampler_ = gl::make_linear_clamp_sampler();
+  gl::check_error("creating the compositor");
+}
+
+// Programs are compiled on first use: llvmpipe takes tens of milliseconds a program, and a run
+// needs only some (the CPU composite table two of the seven).
+GLuint GlCompositor::program(ProgramKind kind) {
+  gl::Program& p = programs_[static_cast<std::size_t>(kind)];
+  if (p) return p.id();
   const std::string subsamples = fmt::format("#define NELF_SUBSAMPLES {}\n", subsamples_per_axis(options_.fsaa));
-  elemental_program_ = gl::make_program("fullscreen.vert", "elemental.frag", subsamples);
-  border_program_ =
-      gl::make_program("border_strips.vert", "elemental.frag", subsamples + "#define NELF_AREA_SAMPLE 1\n");
-  map_program_ = gl::make_program("fullscreen.vert", "elemental.frag", subsamples + "#define NELF_COORDINATE_MAP 1\n");
-  if (options_.fsaa == 1)
-    record_program_ = gl::make_program("border_strips.vert", "elemental.frag",
-                                       subsamples + "#define NELF_AREA_SAMPLE 1\n#define NELF_RECORD_TAPS 1\n");
-  lookup_program_ = gl::make_program("fullscreen.vert", "elemental_lookup.frag");
-  set_uniform_int(lookup_program_.id(), "u_map", 1);
-  reduce_program_ = gl::make_program("fullscreen.vert", "prefilter_reduce.frag");
-  box_program_ = gl::make_program("fullscreen.vert", "prefilter_box.frag");
-  for (GLuint program :
-       {elemental_program_.id(), border_program_.id(), reduce_program_.id(), box_program_.id(), lookup_program_.id()})
-    set_uniform_int(program, program == box_program_.id() ? "u_input" : "u_view", 0);
+  const char* sampler = "u_view";
+  switch (kind) {
+    case ProgramKind::elemental:
+      p = gl::make_program("fullscreen.vert", "elemental.frag", subsamples);
+      break;
+    case ProgramKind::border:
+      p = gl::make_program("border_strips.vert", "elemental.frag", subsamples + "#define NELF_AREA_SAMPLE 1\n");
+      break;
+    case ProgramKind::map:
+      p = gl::make_program("fullscreen.vert", "elemental.frag", subsamples + "#define NELF_COORDINATE_MAP 1\n");
+      sampler = nullptr;
+      break;
+    case ProgramKind::record:
+      p = gl::make_program("border_strips.vert", "elemental.frag",
+                           subsamples + "#define NELF_AREA_SAMPLE 1\n#define NELF_RECORD_TAPS 1\n");
+      sampler = nullptr;
+      break;
+    case ProgramKind::lookup:
+      p = gl::make_program("fullscreen.vert", "elemental_lookup.frag");
+      set_uniform_int(p.id(), "u_map", 1);
+      break;
+    case ProgramKind::reduce:
+      p = gl::make_program("fullscreen.vert", "prefilter_reduce.frag");
+      break;
+    case ProgramKind::box:
+      p = gl::make_program("fullscreen.vert", "prefilter_box.frag");
+      sampler = "u_input";
+      break;
+  }
+  if (sampler) set_uniform_int(p.id(), sampler, 0);
   gl::check_error("creating the compositor's programs");
+  return p.id();
 }
 
 GlCompositor::~GlCompositor() {
@@ -150,23 +175,23 @@ GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, i
   if (reduce) {
     glBindFramebuffer(GL_FRAMEBUFFER, t.reduced_fbo.id());
     glViewport(0, 0, plan.reduced[0], plan.reduced[1]);
-    glUseProgram(reduce_program_.id());
-    set_uniform_int(reduce_program_.id(), "u_block", plan.block[0], plan.block[1]);
+    glUseProgram(program(ProgramKind::reduce));
+    set_uniform_int(program(ProgramKind::reduce), "u_block", plan.block[0], plan.block[1]);
     glBindTextureUnit(0, input);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     input = t.reduced_texture.id();
   }
-  glUseProgram(box_program_.id());
+  glUseProgram(program(ProgramKind::box));
   const int view_size[2] = {view_width, view_height};
   const auto box_pass = [&](int axis, GLuint fbo, std::array<int, 2> size, double cell) {
-    set_uniform(box_program_.id(), "u_out_origin", f(-plan.margin[axis] * plan.spacing[axis]));
-    set_uniform(box_program_.id(), "u_view_extent", f(view_size[axis]));
+    set_uniform(program(ProgramKind::box), "u_out_origin", f(-plan.margin[axis] * plan.spacing[axis]));
+    set_uniform(program(ProgramKind::box), "u_view_extent", f(view_size[axis]));
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, size[0], size[1]);
-    set_uniform_int(box_program_.id(), "u_axis", axis);
-    set_uniform(box_program_.id(), "u_cell_size", f(cell));
-    set_uniform(box_program_.id(), "u_out_spacing", f(plan.spacing[axis]));
-    set_uniform(box_program_.id(), "u_box_width", f(plan.box[axis]));
+    set_uniform_int(program(ProgramKind::box), "u_axis", axis);
+    set_uniform(program(ProgramKind::box), "u_cell_size", f(cell));
+    set_uniform(program(ProgramKind::box), "u_out_spacing", f(plan.spacing[axis]));
+    set_uniform(program(ProgramKind::box), "u_box_width", f(plan.box[axis]));
     glBindTextureUnit(0, input);
     glDrawArrays(GL_TRIANGLES, 0, 3);
   };
@@ -220,11 +245,11 @@ void GlCompositor::draw_coordinate_map(const EyeMapping& m, const TextureTransfo
   map.fbo.reset();
   map.texture = gl::make_texture_2d(GL_RG32F, m.panel[0], m.panel[1]);
   map.fbo = gl::make_framebuffer(map.texture);
-  set_mapping_uniforms(map_program_.id(), m, texture, 0, 0);
+  set_mapping_uniforms(program(ProgramKind::map), m, texture, 0, 0);
   glBindVertexArray(empty_vertex_array_.id());
   glBindFramebuffer(GL_FRAMEBUFFER, map.fbo.id());
   glViewport(0, 0, m.panel[0], m.panel[1]);
-  glUseProgram(map_program_.id());
+  glUseProgram(program(ProgramKind::map));
   glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
@@ -268,8 +293,9 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
   const bool new_map =
       use_map && (!coordinate_maps_[e].texture || coordinate_maps_[e].width != view.width ||
                   coordinate_maps_[e].height != view.height || coordinate_maps_[e].aspect != view.aspect());
-  for (const GLuint p : {elemental_program_.id(), border_program_.id()})
-    set_mapping_uniforms(p, m, texture, target.x, target.y);
+  const bool border_strips = options_.fsaa != 0 && m.has_lens_array;
+  if (!use_map) set_mapping_uniforms(program(ProgramKind::elemental), m, texture, target.x, target.y);
+  if (border_strips) set_mapping_uniforms(program(ProgramKind::border), m, texture, target.x, target.y);
   glBindVertexArray(empty_vertex_array_.id());
   CoordinateMap& map = coordinate_maps_[e];
   if (new_map) {
@@ -285,14 +311,14 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
   if (use_map) {
     glBindSampler(1, 0);
     glBindTextureUnit(1, map.texture.id());
-    set_uniform(lookup_program_.id(), "u_region_origin", f(target.x), f(target.y));
-    glUseProgram(lookup_program_.id());
+    set_uniform(program(ProgramKind::lookup), "u_region_origin", f(target.x), f(target.y));
+    glUseProgram(program(ProgramKind::lookup));
   } else {
-    glUseProgram(elemental_program_.id());
+    glUseProgram(program(ProgramKind::elemental));
   }
   glDrawArrays(GL_TRIANGLES, 0, 3);
-  if (options_.fsaa != 0 && m.has_lens_array) {
-    glUseProgram(border_program_.id());
+  if (border_strips) {
+    glUseProgram(program(ProgramKind::border));
     glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
   }
   gl::check_error("rendering an eye image");
@@ -337,16 +363,16 @@ std::optional<CompositeTable::Recording> GlCompositor::record_composite_table(Ey
     // The border strips write down each part's tap instead of taking it, a part per pass.
     const gl::Texture part_texture = gl::make_texture_2d(GL_RGBA32F, width, height);
     const gl::Framebuffer fbo = gl::make_framebuffer(part_texture);
-    set_mapping_uniforms(record_program_.id(), m, texture, 0, 0);
+    set_mapping_uniforms(program(ProgramKind::record), m, texture, 0, 0);
     glBindVertexArray(empty_vertex_array_.id());
     glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
     glViewport(0, 0, width, height);
-    glUseProgram(record_program_.id());
+    glUseProgram(program(ProgramKind::record));
     std::vector<float> part(4 * pixels);
     for (int k = 0; k < 4; ++k) {
       const GLfloat zero[4] = {0.f, 0.f, 0.f, 0.f};
       glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, zero);
-      set_uniform_int(record_program_.id(), "u_part", k);
+      set_uniform_int(program(ProgramKind::record), "u_part", k);
       glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
       glGetTextureImage(part_texture.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(part.size() * sizeof(float)),
                         part.data());

@@ -160,8 +160,12 @@ class GlCompositor final : public Compositor {
   CompositorOptions options_;
   gl::VertexArray empty_vertex_array_;
   gl::Sampler sampler_;
-  gl::Program elemental_program_, border_program_, reduce_program_, box_program_, map_program_, lookup_program_;
-  gl::Program record_program_;  // fsaa 1: the border strips writing down their taps (make_composite_table)
+  // elemental: pass 1 from the view; border: the strips' area split; map: the coordinate map;
+  // lookup: pass 1 through the map; reduce, box: the prefilter; record: the strips writing down
+  // their taps (record_composite_table).
+  enum class ProgramKind { elemental, border, map, lookup, reduce, box, record };
+  GLuint program(ProgramKind kind);
+  std::array<gl::Program, 7> programs_;
   std::array<CoordinateMap, 2> coordinate_maps_;       // per eye, fsaa 1
   std::array<PrefilterTargets, 2> prefilter_targets_;  // per eye
   std::array<UploadedView, 2> uploads_;                // per eye, for compose()
