@@ -62,6 +62,16 @@ Mean mean_of(const Image& image) {
   return m;
 }
 
+// Pixels of the calibration grid's yellow centre cross and its lines (neither view has yellow).
+int grid_pixels(const Image& image) {
+  int n = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(image.width()) * image.height(); ++i) {
+    const float* q = image.data() + i * 4;
+    if (q[0] > 0.5f && q[1] > 0.5f && q[2] < 0.35f) ++n;
+  }
+  return n;
+}
+
 class PlayerWindowTest : public ::testing::Test {
  protected:
   test::XvfbServer xvfb_;
@@ -274,10 +284,10 @@ class ScopedEnv {
 TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessagesStillShow) {
   // On software GL the player composites 8-bit block means on the CPU from composite tables and
   // uploads the packed frame; NELF_COMPOSITE picks either path. The same clip played both ways,
-  // with 's' pressed at 1 s: its message ("eyes swapped", 2 s) is drawn with GL onto the view
-  // textures, so the table run hands those frames to GL, and then the table again with the eyes
-  // swapped. Every frame both runs rendered (by pts: a loaded machine may drop different ones)
-  // looks the same, text included.
+  // with 's' and 'c' pressed at 1 s: their message (2 s) is drawn with GL onto the view textures,
+  // so the table run hands those frames to GL, and then the table again, eyes swapped and the
+  // calibration grid drawn into the views' bytes. Every frame both runs rendered (by pts: a loaded
+  // machine may drop different ones) looks the same, text and grid included.
   const auto clip = make_clip(dir_, 4);
   PlayerOptions options = silent_options();
   const auto wanted = stereo_prefilter_block(options.profile, options.compositor, 320, 180, 0.0);
@@ -303,6 +313,7 @@ TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessag
           mean_of(read_back(d.packed_framebuffer(), 0, left.y + left.height, 1280, right.y - left.y - left.height))};
       if (!pressed && pts >= 1.0) {
         test::send_key(glfwGetCurrentContext(), "s");
+        test::send_key(glfwGetCurrentContext(), "c");
         pressed = true;
       }
     };
@@ -311,41 +322,47 @@ TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessag
     EXPECT_EQ(play(*display, *source, options).end, PlayEnd::end_of_file);
     ASSERT_TRUE(pressed);
   }
-  // The key arrives with some later poll: the first frame with the blue view on the left is where
-  // each run swapped (and said so).
-  double swapped_at[2] = {0.0, 0.0};
+  // The keys arrive with some later poll: the first frame with the blue view on the left or the
+  // grid is where each run took them (and said so).
+  double keys_at[2] = {0.0, 0.0};
   for (int path : {0, 1}) {
-    const auto swapped = std::find_if(shown[path].begin(), shown[path].end(), [](const auto& f) {
+    const auto changed = std::find_if(shown[path].begin(), shown[path].end(), [](const auto& f) {
       const Mean l = mean_of(f.second.left);
-      return l.b > l.r;
+      return l.b > l.r || grid_pixels(f.second.left) > 0;
     });
-    ASSERT_NE(swapped, shown[path].end()) << "'s' did not swap the eyes";
-    swapped_at[path] = swapped->first;
+    ASSERT_NE(changed, shown[path].end()) << "'s' and 'c' changed nothing";
+    keys_at[path] = changed->first;
   }
-  // Before the swap: the table; after it, while the message surely shows: GL with text in both
-  // runs; once it has surely gone: the table, eyes swapped. Frames between the two runs' swaps, or
-  // around the message's end, may differ in what they show, and are skipped.
-  const double first_key = std::min(swapped_at[0], swapped_at[1]);
-  const double last_key = std::max(swapped_at[0], swapped_at[1]);
+  // Before the keys: the table; after them, while the message surely shows: GL with text in both
+  // runs; once it has surely gone: the table, eyes swapped, grid on. Frames between the two runs'
+  // keys (and a margin for 'c' coming a poll after 's'), or around the message's end, may differ
+  // in what they show, and are skipped.
+  const double first_key = std::min(keys_at[0], keys_at[1]);
+  const double last_key = std::max(keys_at[0], keys_at[1]);
   int before = 0, message = 0, after = 0;
   for (const auto& [pts, table] : shown[0]) {
     const auto gl = shown[1].find(pts);
     if (gl == shown[1].end()) continue;
-    const bool swapped = pts >= last_key;
     if (pts < first_key)
       ++before;
-    else if (swapped && pts < first_key + 1.5)
+    else if (pts >= last_key + 0.3 && pts < first_key + 1.5)
       ++message;
     else if (pts >= last_key + 2.5)
       ++after;
     else
       continue;
     SCOPED_TRACE("frame at " + std::to_string(pts));
-    const Mean l = mean_of(table.left), r = mean_of(table.right);
-    const Mean& red = swapped ? r : l;
-    const Mean& blue = swapped ? l : r;
-    EXPECT_GT(red.r, red.b + 0.2);  // not black: each eye its own view
-    EXPECT_GT(blue.b, blue.r + 0.2);
+    if (pts < first_key) {
+      const Mean l = mean_of(table.left), r = mean_of(table.right);
+      EXPECT_GT(l.r, l.b + 0.2);  // not black: each eye its own view
+      EXPECT_GT(r.b, r.r + 0.2);
+      EXPECT_EQ(grid_pixels(table.left) + grid_pixels(table.right), 0);
+    } else {
+      EXPECT_GT(grid_pixels(table.left), 500);  // the grid on the table path too
+      EXPECT_GT(grid_pixels(table.right), 500);
+      const Mean l = mean_of(table.left), r = mean_of(table.right);
+      EXPECT_GT(r.r - r.b, l.r - l.b + 0.15);  // swapped: the red-ish view now on the right
+    }
     EXPECT_LT(table.gap.max, 0.01);  // the frame-packing gap black on the CPU path too
     for (const auto& [a, b] : {std::pair{&table.left, &gl->second.left}, {&table.right, &gl->second.right}}) {
       double sum = 0.0, worst = 0.0;
@@ -360,8 +377,8 @@ TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessag
       EXPECT_LT(worst, 4.5 / 255);            // and the text box shows on both (far more than that)
     }
   }
-  const std::string why = fmt::format("{} frames in the table run, {} in the GL run; swapped at {} and {} s",
-                                      shown[0].size(), shown[1].size(), swapped_at[0], swapped_at[1]);
+  const std::string why = fmt::format("{} frames in the table run, {} in the GL run; keys taken at {} and {} s",
+                                      shown[0].size(), shown[1].size(), keys_at[0], keys_at[1]);
   EXPECT_GE(before, 5) << why;
   EXPECT_GE(message, 5) << why;
   EXPECT_GE(after, 5) << why;
