@@ -2,7 +2,8 @@
 // Live sinks (DESIGN.md §7): a desktop window, fullscreen 1:1 on a monitor, quad-buffer stereo, or
 // KMS scan-out. `nelf play` and `nelf calibrate` render every packed frame with the GL compositor
 // into the display's packed framebuffer (GlCompositor::render_eye at the eye areas of
-// hmz_output/packing), then call present(). Each kind of display is its own file
+// hmz_output/packing), or (`nelf play` on software GL) on the CPU from composite tables into its
+// texture, then call present(). Each kind of display is its own file
 // (window_display.*, kms_display.*) with its own factory; this header is the contract between them
 // and the commands.
 #include <epoxy/gl.h>
@@ -59,6 +60,9 @@ class Display {
   // A framebuffer object of options.packed size (row 0 = the packed frame's top row, as everywhere
   // in the compositor) holding the frame that present() shows. Never 0.
   virtual GLuint packed_framebuffer() const = 0;
+  // The GL_RGBA8 colour texture of packed_framebuffer(), for renderers that make the frame on the
+  // CPU (the composite table on software GL) and upload it with glTextureSubImage2D instead.
+  virtual GLuint packed_texture() const = 0;
   virtual std::array<int, 2> packed_size() const = 0;
 
   // Shows the packed framebuffer's contents: scaled to fit with its aspect kept (window), 1:1

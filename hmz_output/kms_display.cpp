@@ -277,6 +277,7 @@ class KmsDisplay final : public Display {
 
   std::shared_ptr<gl::Context> context() const override { return context_; }
   GLuint packed_framebuffer() const override { return fbo_.id(); }
+  GLuint packed_texture() const override { return texture_.id(); }
   std::array<int, 2> packed_size() const override { return {width_, height_}; }
   void present() override;
   double refresh_hz() const override { return refresh_hz_; }

@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "compositor/composite_table.hpp"
 #include "compositor/gl/objects.hpp"
 #include "compositor/gl_compositor.hpp"
 #include "compositor/text_overlay.hpp"
@@ -286,10 +287,12 @@ Image cover_grid(const Image& pattern, std::array<int, 2> block) {
   return out;
 }
 
-// The GL side: view textures, the compositor (rebuilt when the optics change) and the eye areas.
+// The GL side: view textures, the compositor (rebuilt when the optics change) and the eye areas;
+// on software GL also the CPU path, composite tables replayed from the views' bytes.
 class PackedRenderer {
  public:
-  PackedRenderer(Display& display, const PlayerOptions& options) : display_(display), options_(options) {
+  PackedRenderer(Display& display, const PlayerOptions& options)
+      : display_(display), options_(options), prefer_tables_(prefer_composite_table(*display.context())) {
     profile_ = options.profile;
     rebuild();
   }
@@ -320,18 +323,22 @@ class PackedRenderer {
       aspect_ = frame.aspect;
       for (auto& t : views_) t = gl::make_texture_2d(bits_ > 8 ? GL_RGBA16 : GL_RGBA8, texture_w(), texture_h());
       update_wanted_blocks();
+      forget_tables();
     }
+    // The textures are filled even when the CPU path will composite this frame: a message or a
+    // key changing the optics hands the next render to GL, which then needs them.
     const GLenum type = bits_ > 8 ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE;
+    const bool keep_bytes = may_use_tables();
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     for (int i = 0; i < 2; ++i) {
       const auto& source = i == 0 ? frame.left : frame.right;
-      if (calibration) {
-        std::vector<std::uint8_t> copy = source;
-        draw_over(copy, calibration_grid(i), bits_);
-        glTextureSubImage2D(views_[i].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, copy.data());
-      } else {
-        glTextureSubImage2D(views_[i].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, source.data());
+      const std::uint8_t* pixels = source.data();
+      if (calibration || keep_bytes) {
+        view_bytes_[i].assign(source.begin(), source.end());
+        if (calibration) draw_over(view_bytes_[i], calibration_grid(i), bits_);
+        pixels = view_bytes_[i].data();
       }
+      glTextureSubImage2D(views_[i].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, pixels);
     }
     gl::check_error("uploading the views");
   }
@@ -358,6 +365,10 @@ class PackedRenderer {
 
   // Both eyes into the display's packed framebuffer; the gap (and any border) black.
   void render(bool swap_eyes) {
+    if (use_tables()) {
+      render_from_tables(swap_eyes);
+      return;
+    }
     const GLuint fbo = display_.packed_framebuffer();
     const float black[4] = {0.f, 0.f, 0.f, 1.f};
     glClearNamedFramebufferfv(fbo, GL_COLOR, 0, black);
@@ -380,6 +391,64 @@ class PackedRenderer {
   }
 
  private:
+  // The CPU path (compositor/composite_table.hpp) replays the fsaa-1 composite of 8-bit block
+  // means several times cheaper than llvmpipe runs the GL passes; prefer_composite_table says
+  // where it pays (software GL, or NELF_COMPOSITE).
+  bool may_use_tables() const { return prefer_tables_ && bits_ == 8 && reduced(); }
+  // Whether this render goes the CPU path: not while a message shows (the overlay is drawn with
+  // GL onto the view textures), nor with block means made for optics a key has changed since
+  // (the GL path's smaller view covers the frames until the new block arrives). Records the
+  // tables on first use for the current views and optics.
+  bool use_tables() {
+    if (view_w_ == 0 || !may_use_tables() || !overlay_.text().empty()) return false;
+    for (Eye eye : {Eye::left, Eye::right})
+      if (origins_[static_cast<int>(eye)] && block_ != wanted_block(eye)) return false;
+    if (!tables_tried_) {
+      tables_tried_ = true;
+      for (Eye eye : {Eye::left, Eye::right}) {
+        const int e = static_cast<int>(eye);
+        if (!origins_[e]) continue;
+        tables_[e] = compositor_->make_composite_table(eye, view_w_, view_h_, aspect_, block_);
+        // No table for these options (fsaa other than 1, no prefilter): GL for both eyes.
+        if (!tables_[e]) {
+          tables_ = {};
+          break;
+        }
+      }
+    }
+    return tables_[0] || tables_[1];
+  }
+  void forget_tables() {
+    tables_ = {};
+    tables_tried_ = false;
+  }
+  // Both eyes into a CPU copy of the packed frame, then that into the display's texture: one
+  // upload of the whole frame, since the eyes' panels are nearly all of it.
+  void render_from_tables(bool swap_eyes) {
+    const auto packed = display_.packed_size();
+    const std::size_t stride = static_cast<std::size_t>(packed[0]) * 4;
+    if (packed_bytes_.size() != stride * packed[1]) {
+      // Black once: the tables write every pixel of the panels, nothing else changes.
+      packed_bytes_.resize(stride * packed[1]);
+      const std::uint8_t black[4] = {0, 0, 0, 255};
+      for (std::size_t i = 0; i < packed_bytes_.size(); i += 4) std::memcpy(&packed_bytes_[i], black, 4);
+    }
+    const std::size_t view_stride = static_cast<std::size_t>(texture_w()) * 4;
+    for (Eye eye : {Eye::left, Eye::right}) {
+      const int e = static_cast<int>(eye);
+      if (!origins_[e] || !tables_[e]) continue;
+      const int view = e ^ (swap_eyes ? 1 : 0);
+      tables_[e]->render(view_bytes_[view].data(), view_stride,
+                         packed_bytes_.data() + static_cast<std::size_t>(origins_[e]->second) * stride +
+                             static_cast<std::size_t>(origins_[e]->first) * 4,
+                         stride);
+    }
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureSubImage2D(display_.packed_texture(), 0, 0, 0, packed[0], packed[1], GL_RGBA, GL_UNSIGNED_BYTE,
+                        packed_bytes_.data());
+    gl::check_error("uploading the packed frame");
+  }
+
   bool reduced() const { return block_[0] > 1 || block_[1] > 1; }
   int texture_w() const { return view_w_ / block_[0]; }
   int texture_h() const { return view_h_ / block_[1]; }
@@ -391,6 +460,8 @@ class PackedRenderer {
   }
 
   void rebuild() {
+    forget_tables();
+    packed_bytes_.clear();  // the eyes may have moved: black again around them
     compositor_.reset();
     compositor_ = std::make_unique<GlCompositor>(profile_, options_.compositor, display_.context());
     update_wanted_blocks();
@@ -423,6 +494,13 @@ class PackedRenderer {
   std::array<int, 2> grid_block_{1, 1};
   std::array<std::optional<std::pair<int, int>>, 2> origins_;
   std::array<gl::Texture, 2> views_;
+  // The CPU path: the views' bytes as in the textures (calibration grid included), the tables
+  // for the current views and optics (recorded when first used), and the packed frame.
+  const bool prefer_tables_;
+  std::array<std::vector<std::uint8_t>, 2> view_bytes_;
+  std::array<std::optional<CompositeTable>, 2> tables_;
+  bool tables_tried_ = false;
+  std::vector<std::uint8_t> packed_bytes_;
   int view_w_ = 0, view_h_ = 0, bits_ = 8;
   std::array<int, 2> block_{1, 1};  // of the views in the textures
   std::array<std::array<int, 2>, 2> wanted_blocks_{};

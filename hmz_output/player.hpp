@@ -2,7 +2,8 @@
 // The player engine behind `nelf play` (DESIGN.md §7): a decode thread fills a bounded queue of
 // stereo frames; the display's thread (the caller's) paces them against the master clock with
 // FrameScheduler, uploads each new frame's two views once, composites both eyes with GlCompositor
-// straight into the display's packed framebuffer and presents. An audio thread feeds SDL2 audio,
+// straight into the display's packed framebuffer (on software GL, 8-bit block means: from composite
+// tables on the CPU, then one upload of the packed frame) and presents. An audio thread feeds SDL2 audio,
 // whose clock is master; without sound a system clock is. Keys change playback and the optics live.
 #include <atomic>
 #include <cstdint>

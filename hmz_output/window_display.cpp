@@ -264,6 +264,7 @@ class WindowDisplay final : public Display {
 
   std::shared_ptr<gl::Context> context() const override { return context_; }
   GLuint packed_framebuffer() const override { return packed_fbo_.id(); }
+  GLuint packed_texture() const override { return packed_texture_.id(); }
   std::array<int, 2> packed_size() const override { return options_.packed; }
 
   void present() override {

@@ -3,12 +3,18 @@
 #include <gtest/gtest.h>
 
 #include <epoxy/gl.h>
+#include <fmt/format.h>
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <map>
+#include <optional>
 #include <set>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "compositor/gl_compositor.hpp"
@@ -17,6 +23,7 @@
 #include "hmz_output/window_display.hpp"
 #include "support/media.hpp"
 #include "support/test_support.hpp"
+#include "support/x11_window.hpp"
 #include "support/xvfb.hpp"
 
 namespace nelf {
@@ -24,15 +31,17 @@ namespace {
 
 Profile small_profile(const test::TempDir& dir) { return load_profile(test::write_small_profile(dir).string()); }
 
-// 2 s at 30 fps, side by side: left view red-ish, right view blue-ish, each with a white box that
-// moves 5 px per frame (the frame number, visible).
-std::filesystem::path make_clip(const test::TempDir& dir) {
+// 2 s (or `seconds`) at 30 fps, side by side: left view red-ish, right view blue-ish, each with a
+// white box that moves 5 px per frame (the frame number, visible).
+std::filesystem::path make_clip(const test::TempDir& dir, int seconds = 2) {
+  const std::string d = ":d=" + std::to_string(seconds);
   return test::make_media(
       dir / "clip.mp4",
-      "-f lavfi -i color=c=0xC03020:s=320x180:r=30:d=2 -f lavfi -i color=c=0x2040C0:s=320x180:r=30:d=2 "
-      "-f lavfi -i color=c=white:s=20x60:r=30:d=2 -filter_complex "
-      "\"[2]split[b1][b2];[0][b1]overlay=x='mod(n*5,300)':y=60[l];[1][b2]overlay=x='mod(n*5,300)':y=60[r];"
-      "[l][r]hstack\" -c:v libx264 -preset ultrafast -pix_fmt yuv420p");
+      "-f lavfi -i color=c=0xC03020:s=320x180:r=30" + d + " -f lavfi -i color=c=0x2040C0:s=320x180:r=30" + d +
+          " -f lavfi -i color=c=white:s=20x60:r=30" + d +
+          " -filter_complex "
+          "\"[2]split[b1][b2];[0][b1]overlay=x='mod(n*5,300)':y=60[l];[1][b2]overlay=x='mod(n*5,300)':y=60[r];"
+          "[l][r]hstack\" -c:v libx264 -preset ultrafast -pix_fmt yuv420p");
 }
 
 struct Mean {
@@ -51,6 +60,16 @@ Mean mean_of(const Image& image) {
   m.g /= n;
   m.b /= n;
   return m;
+}
+
+// Pixels of the calibration grid's yellow centre cross and its lines (neither view has yellow).
+int grid_pixels(const Image& image) {
+  int n = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(image.width()) * image.height(); ++i) {
+    const float* q = image.data() + i * 4;
+    if (q[0] > 0.5f && q[1] > 0.5f && q[2] < 0.35f) ++n;
+  }
+  return n;
 }
 
 class PlayerWindowTest : public ::testing::Test {
@@ -239,6 +258,130 @@ TEST_F(PlayerWindowTest, PlaysFromTheCompositorsBlockMeansWithTheSameImageAsFrom
     EXPECT_LT(sum / (160.0 * 90 * 3), 0.01);
     EXPECT_LT(worst, 0.15);
   }
+}
+
+// Sets an environment variable for a scope, restoring what was there before.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    setenv(name, value, 1);
+  }
+  ~ScopedEnv() {
+    if (old_)
+      setenv(name_.c_str(), old_->c_str(), 1);
+    else
+      unsetenv(name_.c_str());
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  std::string name_;
+  std::optional<std::string> old_;
+};
+
+TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessagesStillShow) {
+  // On software GL the player composites 8-bit block means on the CPU from composite tables and
+  // uploads the packed frame; NELF_COMPOSITE picks either path. The same clip played both ways,
+  // with 's' and 'c' pressed at 1 s: their message (2 s) is drawn with GL onto the view textures,
+  // so the table run hands those frames to GL, and then the table again, eyes swapped and the
+  // calibration grid drawn into the views' bytes. Every frame both runs rendered (by pts: a loaded
+  // machine may drop different ones) looks the same, text and grid included.
+  const auto clip = make_clip(dir_, 4);
+  PlayerOptions options = silent_options();
+  const auto wanted = stereo_prefilter_block(options.profile, options.compositor, 320, 180, 0.0);
+  ASSERT_TRUE(wanted[0] > 1 || wanted[1] > 1) << "the table needs block means";
+  auto display = open_display(options);
+  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
+  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
+  const auto panel = [](const Display& d, const EyeArea& a) {
+    return read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90);
+  };
+  struct Frame {
+    Image left, right;
+    Mean gap;
+  };
+  std::map<double, Frame> shown[2];  // [0]: table, [1]: gl
+  for (int path : {0, 1}) {
+    const ScopedEnv composite("NELF_COMPOSITE", path == 0 ? "table" : "gl");
+    bool pressed = false;
+    options.after_render = [&](const Display& d, double pts) {
+      // A redraw of the same pts (the message's) replaces the frame.
+      shown[path][pts] = Frame{
+          panel(d, left), panel(d, right),
+          mean_of(read_back(d.packed_framebuffer(), 0, left.y + left.height, 1280, right.y - left.y - left.height))};
+      if (!pressed && pts >= 1.0) {
+        test::send_key(glfwGetCurrentContext(), "s");
+        test::send_key(glfwGetCurrentContext(), "c");
+        pressed = true;
+      }
+    };
+    auto source = open_stereo_frame_source(
+        StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
+    EXPECT_EQ(play(*display, *source, options).end, PlayEnd::end_of_file);
+    ASSERT_TRUE(pressed);
+  }
+  // The keys arrive with some later poll: the first frame with the blue view on the left or the
+  // grid is where each run took them (and said so).
+  double keys_at[2] = {0.0, 0.0};
+  for (int path : {0, 1}) {
+    const auto changed = std::find_if(shown[path].begin(), shown[path].end(), [](const auto& f) {
+      const Mean l = mean_of(f.second.left);
+      return l.b > l.r || grid_pixels(f.second.left) > 0;
+    });
+    ASSERT_NE(changed, shown[path].end()) << "'s' and 'c' changed nothing";
+    keys_at[path] = changed->first;
+  }
+  // Before the keys: the table; after them, while the message surely shows: GL with text in both
+  // runs; once it has surely gone: the table, eyes swapped, grid on. Frames between the two runs'
+  // keys (and a margin for 'c' coming a poll after 's'), or around the message's end, may differ
+  // in what they show, and are skipped.
+  const double first_key = std::min(keys_at[0], keys_at[1]);
+  const double last_key = std::max(keys_at[0], keys_at[1]);
+  int before = 0, message = 0, after = 0;
+  for (const auto& [pts, table] : shown[0]) {
+    const auto gl = shown[1].find(pts);
+    if (gl == shown[1].end()) continue;
+    if (pts < first_key)
+      ++before;
+    else if (pts >= last_key + 0.3 && pts < first_key + 1.5)
+      ++message;
+    else if (pts >= last_key + 2.5)
+      ++after;
+    else
+      continue;
+    SCOPED_TRACE("frame at " + std::to_string(pts));
+    if (pts < first_key) {
+      const Mean l = mean_of(table.left), r = mean_of(table.right);
+      EXPECT_GT(l.r, l.b + 0.2);  // not black: each eye its own view
+      EXPECT_GT(r.b, r.r + 0.2);
+      EXPECT_EQ(grid_pixels(table.left) + grid_pixels(table.right), 0);
+    } else {
+      EXPECT_GT(grid_pixels(table.left), 500);  // the grid on the table path too
+      EXPECT_GT(grid_pixels(table.right), 500);
+      const Mean l = mean_of(table.left), r = mean_of(table.right);
+      EXPECT_GT(r.r - r.b, l.r - l.b + 0.15);  // swapped: the red-ish view now on the right
+    }
+    EXPECT_LT(table.gap.max, 0.01);  // the frame-packing gap black on the CPU path too
+    for (const auto& [a, b] : {std::pair{&table.left, &gl->second.left}, {&table.right, &gl->second.right}}) {
+      double sum = 0.0, worst = 0.0;
+      const std::size_t n = static_cast<std::size_t>(a->width()) * a->height();
+      for (std::size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 4; ++c) {  // alpha too: the CPU path writes it opaque, as GL does
+          const double d = std::abs(a->data()[i * 4 + c] - b->data()[i * 4 + c]);
+          sum += d;
+          worst = std::max(worst, d);
+        }
+      EXPECT_LT(sum / (4.0 * n), 1.0 / 255);  // the table agrees with GL to a code value or two
+      EXPECT_LT(worst, 4.5 / 255);            // and the text box shows on both (far more than that)
+    }
+  }
+  const std::string why = fmt::format("{} frames in the table run, {} in the GL run; keys taken at {} and {} s",
+                                      shown[0].size(), shown[1].size(), keys_at[0], keys_at[1]);
+  EXPECT_GE(before, 5) << why;
+  EXPECT_GE(message, 5) << why;
+  EXPECT_GE(after, 5) << why;
 }
 
 }  // namespace
