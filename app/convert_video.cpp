@@ -295,34 +295,25 @@ class PackedFrameRenderer {
   bool tables_from_cache(const VideoConvertRequest& r, const CompositeTableCache& cache, double aspect) {
     const CompositeChoice choice = composite_choice();
     if (choice == CompositeChoice::gl || (choice == CompositeChoice::automatic && has_render_node())) return false;
+    return load_tables(r, cache, nullptr, aspect);
+  }
+  // Both eyes' tables recorded with the GL compositor (and kept in `cache`), or none when one has
+  // no table (fsaa other than 1, whole views).
+  void record_tables(const VideoConvertRequest& r, const CompositeTableCache& cache, double aspect) {
+    load_tables(r, cache, &*compositor_, aspect);
+  }
+  bool load_tables(const VideoConvertRequest& r, const CompositeTableCache& cache, GlCompositor* recorder,
+                   double aspect) {
     for (Eye eye : {Eye::left, Eye::right}) {
       if (!origins_[static_cast<int>(eye)]) continue;
-      auto recording = cache.load(composite_table_key(r.profile, r.compositor, eye, view_w_, view_h_, aspect, block_));
-      try {
-        if (!recording || recording->panel != panel_ ||
-            recording->reduced != std::array<int, 2>{texture_w(), texture_h()})
-          throw std::invalid_argument("not cached");
-        tables_[static_cast<int>(eye)].emplace(*recording);
-      } catch (const std::invalid_argument&) {  // missing, or not a table for these views
+      tables_[static_cast<int>(eye)] = load_or_record_composite_table(cache, recorder, r.profile, r.compositor, eye,
+                                                                      view_w_, view_h_, aspect, block_);
+      if (!tables_[static_cast<int>(eye)]) {
         tables_ = {};
         return false;
       }
     }
     return tables_[0] || tables_[1];
-  }
-  // Both eyes' tables recorded with the GL compositor (and kept in `cache`), or none when one has
-  // no table (fsaa other than 1, whole views).
-  void record_tables(const VideoConvertRequest& r, const CompositeTableCache& cache, double aspect) {
-    for (Eye eye : {Eye::left, Eye::right}) {
-      if (!origins_[static_cast<int>(eye)]) continue;
-      auto recording = compositor_->record_composite_table(eye, view_w_, view_h_, aspect, block_);
-      if (!recording) {
-        tables_ = {};
-        return;
-      }
-      cache.store(composite_table_key(r.profile, r.compositor, eye, view_w_, view_h_, aspect, block_), *recording);
-      tables_[static_cast<int>(eye)].emplace(*recording);
-    }
   }
 
   // The CPU path: both eyes from their tables straight into the packed frame, black around them.
@@ -333,9 +324,9 @@ class PackedFrameRenderer {
     const auto render_eye = [&](int e) {
       if (!origins_[e] || !tables_[e]) return;
       const auto& view = e == 0 ? f.left : f.right;
-      tables_[e]->render(view.data(), static_cast<std::size_t>(texture_w()) * 4,
-                         out.rgba.data() + origins_[e]->second * stride + static_cast<std::size_t>(origins_[e]->first) * 4,
-                         stride);
+      tables_[e]->render(
+          view.data(), static_cast<std::size_t>(texture_w()) * 4,
+          out.rgba.data() + origins_[e]->second * stride + static_cast<std::size_t>(origins_[e]->first) * 4, stride);
     };
     // The eyes in parallel: while x264 fills its look-ahead the compositing is what the pipeline
     // waits for, and each table has its own scratch buffers.

@@ -7,11 +7,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <stdexcept>
 #include <system_error>
 #include <type_traits>
 #include <vector>
 
 #include "compositor/embedded.hpp"
+#include "compositor/gl_compositor.hpp"
 
 namespace nelf {
 
@@ -168,6 +170,29 @@ bool CompositeTableCache::store(const std::string& key, const CompositeTable::Re
   if (!ec) return true;
   std::filesystem::remove(temporary, ec);
   return false;
+}
+
+std::optional<CompositeTable> load_or_record_composite_table(const CompositeTableCache& cache, GlCompositor* recorder,
+                                                             const Profile& profile, const CompositorOptions& options,
+                                                             Eye eye, int view_width, int view_height, double aspect,
+                                                             std::array<int, 2> block) {
+  const std::string key = composite_table_key(profile, options, eye, view_width, view_height, aspect, block);
+  if (auto recording = cache.load(key)) {
+    // An entry for this key describes these views; one that does not (or does not hold together)
+    // is recorded again.
+    const std::array<int, 2> reduced{view_width / block[0], view_height / block[1]};
+    if (recording->panel == profile.display.resolution && recording->reduced == reduced) {
+      try {
+        return CompositeTable(*recording);
+      } catch (const std::invalid_argument&) {
+      }
+    }
+  }
+  if (!recorder) return std::nullopt;
+  auto recording = recorder->record_composite_table(eye, view_width, view_height, aspect, block);
+  if (!recording) return std::nullopt;
+  cache.store(key, *recording);
+  return CompositeTable(*recording);
 }
 
 bool has_render_node() {

@@ -41,6 +41,17 @@ class CompositeTableCache {
   std::filesystem::path directory_;
 };
 
+class GlCompositor;
+
+// The table for `eye` of `profile` and views of view_width×view_height at `aspect`, averaged in
+// `block`: from `cache` when it holds a usable one, else recorded with `recorder` (when given) and
+// stored in `cache`. Nothing when neither works (no entry and no recorder, or no table for these
+// options: fsaa other than 1, whole views).
+std::optional<CompositeTable> load_or_record_composite_table(const CompositeTableCache& cache, GlCompositor* recorder,
+                                                             const Profile& profile, const CompositorOptions& options,
+                                                             Eye eye, int view_width, int view_height, double aspect,
+                                                             std::array<int, 2> block);
+
 // True when the machine has a DRM render node (/dev/dri/renderD*): a GPU may be there, so the
 // GL context decides between GL and the CPU table rather than a cached table.
 bool has_render_node();
