@@ -78,13 +78,13 @@ class CompositeTable {
   Tap make_tap(float x, float y) const;
   static void replay_taps(const Tap* taps, int count, const std::uint8_t* image, std::size_t image_row,
                           std::uint8_t* out);
-  void box_pass();
+  void box_pass(const std::uint8_t* reduced, std::size_t reduced_stride);
 
   std::array<int, 2> panel_, reduced_, prefiltered_;
   BoxAxis horizontal_, vertical_;
   std::vector<Tap> taps_;             // per pixel, pass 1
   std::vector<BorderPixel> borders_;  // pass 2
-  std::vector<float> input_;          // the block means, RGBA as float
+  std::vector<float> input_;          // one row of the block means, RGBA as float
   std::vector<float> across_;         // after the horizontal box pass: prefiltered[0] × reduced[1], RGBA
   std::vector<std::uint8_t> image_;   // the prefiltered image: prefiltered[0] × prefiltered[1], RGBA8
   std::vector<float> row_sums_;       // the vertical box pass's accumulators, RGBA per column
