@@ -223,8 +223,9 @@ class BufferPool {
   std::vector<std::vector<std::uint8_t>> free_;
 };
 
-// The GL stage: uploads each frame's views, renders both eyes straight into the packed frame and
-// reads it back for the encoder.
+// The compositing stage: both eyes of each frame into a packed frame for the encoder, from CPU
+// composite tables on software GL (see below), else with GL (upload the views, render straight
+// into the packed frame, read it back).
 class PackedFrameRenderer {
  public:
   PackedFrameRenderer(const VideoConvertRequest& r, int view_w, int view_h, int bits, double aspect,
