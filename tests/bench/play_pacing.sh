@@ -27,6 +27,7 @@ cleanup() {
 }
 trap cleanup EXIT
 export MESA_SHADER_CACHE_DIR=$work/shader-cache
+export NELF_CACHE_DIR=$work/nelf-cache  # composite tables: recorded on the first frame, as on a first play
 
 # A private X server on a free display number (Xvfb writes it to the fd we give it).
 exec {displayfd}<> <(:)
