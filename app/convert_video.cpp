@@ -253,7 +253,7 @@ class PackedFrameRenderer {
     if (bits == 8 && tables_from_cache(r, cache, aspect)) return;
     compositor_.emplace(r.profile, r.compositor,
                         std::make_shared<gl::EglContext>(gl::ContextOptions{r.compositor.gpu}));
-    if (bits == 8 && prefer_composite_table(compositor_->context())) record_tables(r, cache, aspect);
+    if (bits == 8 && prefer_composite_table(compositor_->context())) load_tables(r, cache, &*compositor_, aspect);
     if (tables_[0] || tables_[1]) return;
     const GLenum internal = bits > 8 ? GL_RGBA16 : GL_RGBA8;
     for (auto& t : views_) t = gl::make_texture_2d(internal, texture_w(), texture_h());
@@ -298,11 +298,8 @@ class PackedFrameRenderer {
     if (choice == CompositeChoice::gl || (choice == CompositeChoice::automatic && has_render_node())) return false;
     return load_tables(r, cache, nullptr, aspect);
   }
-  // Both eyes' tables recorded with the GL compositor (and kept in `cache`), or none when one has
-  // no table (fsaa other than 1, whole views).
-  void record_tables(const VideoConvertRequest& r, const CompositeTableCache& cache, double aspect) {
-    load_tables(r, cache, &*compositor_, aspect);
-  }
+  // Both eyes' tables from `cache`, else recorded with `recorder` (when given, and kept in
+  // `cache`); none when an eye has no table (fsaa other than 1, whole views).
   bool load_tables(const VideoConvertRequest& r, const CompositeTableCache& cache, GlCompositor* recorder,
                    double aspect) {
     for (Eye eye : {Eye::left, Eye::right}) {
@@ -321,19 +318,10 @@ class PackedFrameRenderer {
   PackedFrame render_from_tables(const StereoVideoFrame& f, BufferPool& buffers) {
     PackedFrame out{width_, height_, 8, buffers.take(static_cast<std::size_t>(width_) * height_ * 4), f.pts_s};
     fill_outside_eyes(out.rgba.data());
-    const std::size_t stride = static_cast<std::size_t>(width_) * 4;
-    const auto render_eye = [&](int e) {
-      if (!origins_[e] || !tables_[e]) return;
-      const auto& view = e == 0 ? f.left : f.right;
-      tables_[e]->render(
-          view.data(), static_cast<std::size_t>(texture_w()) * 4,
-          out.rgba.data() + origins_[e]->second * stride + static_cast<std::size_t>(origins_[e]->first) * 4, stride);
-    };
-    // The eyes in parallel: while x264 fills its look-ahead the compositing is what the pipeline
-    // waits for, and each table has its own scratch buffers.
-    auto right = std::async(std::launch::async, render_eye, 1);
-    render_eye(0);
-    right.get();
+    // While x264 fills its look-ahead the compositing is what the pipeline waits for: the eyes
+    // render in parallel.
+    render_packed_eyes(tables_, {f.left.data(), f.right.data()}, static_cast<std::size_t>(texture_w()) * 4, origins_,
+                       out.rgba.data(), static_cast<std::size_t>(width_) * 4);
     return out;
   }
   // Opaque black wherever the eyes do not draw (the gap, and borders when a panel is smaller than

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <future>
 #include <stdexcept>
 
 #if defined(__SSE2__)
@@ -260,6 +261,22 @@ void CompositeTable::render(const std::uint8_t* reduced, std::size_t reduced_str
     }
     store_unorm8(out + static_cast<std::size_t>(b.pixel / width) * out_stride + 4 * (b.pixel % width), sum);
   }
+}
+
+void render_packed_eyes(std::array<std::optional<CompositeTable>, 2>& tables,
+                        const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride,
+                        const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::uint8_t* packed,
+                        std::size_t stride) {
+  const auto render_eye = [&](int e) {
+    if (!origins[e] || !tables[e]) return;
+    tables[e]->render(views[e], view_stride,
+                      packed + static_cast<std::size_t>(origins[e]->second) * stride +
+                          static_cast<std::size_t>(origins[e]->first) * 4,
+                      stride);
+  };
+  auto right = std::async(std::launch::async, render_eye, 1);
+  render_eye(0);
+  right.get();
 }
 
 }  // namespace nelf

@@ -15,6 +15,8 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <utility>
 #include <vector>
 
 namespace nelf {
@@ -89,5 +91,14 @@ class CompositeTable {
   std::vector<std::uint8_t> image_;   // the prefiltered image: prefiltered[0] × prefiltered[1], RGBA8
   std::vector<float> row_sums_;       // the vertical box pass's accumulators, RGBA per column
 };
+
+// Both eyes of a stereo frame into a packed RGBA8 frame (row 0 the top row, `stride` bytes a row),
+// the two in parallel (each table has its own scratch buffers, so the frame is ready sooner): eye e,
+// when it has a table and an origin, renders views[e] (block means, `view_stride` bytes a row) with
+// its panel's top-left corner at origins[e] (x, y). Pixels outside the panels are left as they are.
+void render_packed_eyes(std::array<std::optional<CompositeTable>, 2>& tables,
+                        const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride,
+                        const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::uint8_t* packed,
+                        std::size_t stride);
 
 }  // namespace nelf

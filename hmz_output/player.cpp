@@ -10,14 +10,12 @@
 #include <cstring>
 #include <deque>
 #include <exception>
-#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
 #include <vector>
 
-#include "compositor/composite_table.hpp"
 #include "compositor/composite_table_cache.hpp"
 #include "compositor/gl/objects.hpp"
 #include "compositor/gl_compositor.hpp"
@@ -438,19 +436,9 @@ class PackedRenderer {
       const std::uint8_t black[4] = {0, 0, 0, 255};
       for (std::size_t i = 0; i < packed_bytes_.size(); i += 4) std::memcpy(&packed_bytes_[i], black, 4);
     }
-    const std::size_t view_stride = static_cast<std::size_t>(texture_w()) * 4;
-    const auto render_eye = [&](int e) {
-      if (!origins_[e] || !tables_[e]) return;
-      const int view = e ^ (swap_eyes ? 1 : 0);
-      tables_[e]->render(view_bytes_[view].data(), view_stride,
-                         packed_bytes_.data() + static_cast<std::size_t>(origins_[e]->second) * stride +
-                             static_cast<std::size_t>(origins_[e]->first) * 4,
-                         stride);
-    };
-    // The eyes in parallel (each table has its own scratch buffers): the frame is ready sooner.
-    auto right = std::async(std::launch::async, render_eye, 1);
-    render_eye(0);
-    right.get();
+    const int swap = swap_eyes ? 1 : 0;
+    render_packed_eyes(tables_, {view_bytes_[swap].data(), view_bytes_[1 - swap].data()},
+                       static_cast<std::size_t>(texture_w()) * 4, origins_, packed_bytes_.data(), stride);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTextureSubImage2D(display_.packed_texture(), 0, 0, 0, packed[0], packed[1], GL_RGBA, GL_UNSIGNED_BYTE,
                         packed_bytes_.data());
