@@ -1,7 +1,5 @@
 #include "app/heatmap.hpp"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 #include <fmt/format.h>
 #include <algorithm>
 #include <array>
@@ -11,6 +9,7 @@
 
 #include "app/commands.hpp"
 #include "compositor/chart_style.hpp"
+#include "compositor/image_library.hpp"
 #include "hmz_output/image_sink.hpp"
 
 namespace nelf::app {
@@ -21,37 +20,46 @@ using Colour = chart::Rgb;
 
 using chart::viridis;
 
+// A white float RGB raster with filled rectangles and text (OpenImageIO's).
 class Canvas {
  public:
   Canvas(int width, int height)
-      : buffer_(OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT)), font_(chart::font()) {
-    OIIO::ImageBufAlgo::fill(buffer_, {1.f, 1.f, 1.f});
-  }
+      : width_(width),
+        height_(height),
+        pixels_(static_cast<std::size_t>(width) * height * 3, 1.f),
+        font_(chart::font()) {}
   void rectangle(int x0, int y0, int x1, int y1, const Colour& c) {
-    OIIO::ImageBufAlgo::fill(buffer_, {c[0], c[1], c[2]}, OIIO::ROI(x0, x1, y0, y1, 0, 1, 0, 3));
+    for (int y = std::max(y0, 0); y < std::min(y1, height_); ++y)
+      for (int x = std::max(x0, 0); x < std::min(x1, width_); ++x)
+        std::copy(c.begin(), c.end(), pixels_.begin() + (static_cast<std::ptrdiff_t>(y) * width_ + x) * 3);
   }
-  void text(int x, int y, const std::string& s, int size, OIIO::ImageBufAlgo::TextAlignX align_x,
-            OIIO::ImageBufAlgo::TextAlignY align_y = OIIO::ImageBufAlgo::TextAlignY::Center,
-            const Colour& c = {0.f, 0.f, 0.f}) {
-    const float colour[3] = {c[0], c[1], c[2]};
-    if (!OIIO::ImageBufAlgo::render_text(buffer_, x, y, s, size, font_, colour, align_x, align_y))
+  void text(int x, int y, const std::string& s, int size, image_library::AlignX align_x,
+            image_library::AlignY align_y = image_library::AlignY::center, const Colour& c = {0.f, 0.f, 0.f}) {
+    try {
+      image_library::render_text({.values = pixels_.data(), .width = width_, .height = height_, .channels = 3}, x, y, s,
+                                 size, font_, c, align_x, align_y);
+    } catch (const image_library::ImageLibraryError& e) {
       throw UserError(
           fmt::format("cannot draw the heatmap labels ({}): install a TrueType font, e.g. Debian's "
                       "fonts-dejavu-core",
-                      buffer_.geterror()));
+                      e.what()));
+    }
   }
-  OIIO::ImageBuf& buffer() { return buffer_; }
+  image_library::Picture picture() const {
+    return {.values = pixels_.data(), .width = width_, .height = height_, .channels = 3, .pixel_stride = 3};
+  }
 
  private:
-  OIIO::ImageBuf buffer_;
+  int width_, height_;
+  std::vector<float> pixels_;
   std::string font_;
 };
 
 }  // namespace
 
 void write_heatmap_png(const Heatmap& map, const std::filesystem::path& path) {
-  using AlignX = OIIO::ImageBufAlgo::TextAlignX;
-  using AlignY = OIIO::ImageBufAlgo::TextAlignY;
+  using AlignX = image_library::AlignX;
+  using AlignY = image_library::AlignY;
   const int rows = static_cast<int>(map.y_ticks.size()), columns = static_cast<int>(map.x_ticks.size());
   if (rows == 0 || columns == 0 || static_cast<int>(map.values.size()) != rows)
     throw std::invalid_argument("heatmap: ticks and values disagree");
@@ -68,7 +76,7 @@ void write_heatmap_png(const Heatmap& map, const std::filesystem::path& path) {
   const int plot_w = columns * cell_w, plot_h = rows * cell_h;
   Canvas canvas(left + plot_w + bar_gap + bar_w + right, top + plot_h + bottom);
 
-  canvas.text(left + plot_w / 2, top / 2, map.title, 20, AlignX::Center);
+  canvas.text(left + plot_w / 2, top / 2, map.title, 20, AlignX::center);
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < columns; ++c) {
       const double v = map.values[r][c];
@@ -79,14 +87,14 @@ void write_heatmap_png(const Heatmap& map, const std::filesystem::path& path) {
       const double luminance = 0.2126 * colour[0] + 0.7152 * colour[1] + 0.0722 * colour[2];
       const Colour ink = luminance > 0.45 ? Colour{0.f, 0.f, 0.f} : Colour{1.f, 1.f, 1.f};
       canvas.text(x0 + cell_w / 2, y0 + cell_h / 2, std::isfinite(v) ? fmt::format("{:.0f}", v) : "-", 14,
-                  AlignX::Center, AlignY::Center, ink);
+                  AlignX::center, AlignY::center, ink);
     }
-    canvas.text(left - 8, top + r * cell_h + cell_h / 2, map.y_ticks[r], 14, AlignX::Right);
+    canvas.text(left - 8, top + r * cell_h + cell_h / 2, map.y_ticks[r], 14, AlignX::right);
   }
   for (int c = 0; c < columns; ++c)
-    canvas.text(left + c * cell_w + cell_w / 2, top + plot_h + 14, map.x_ticks[c], 13, AlignX::Center);
-  canvas.text(left + plot_w / 2, top + plot_h + 50, map.x_label, 16, AlignX::Center);
-  canvas.text(10, top - 14, map.y_label, 16, AlignX::Left);
+    canvas.text(left + c * cell_w + cell_w / 2, top + plot_h + 14, map.x_ticks[c], 13, AlignX::center);
+  canvas.text(left + plot_w / 2, top + plot_h + 50, map.x_label, 16, AlignX::center);
+  canvas.text(10, top - 14, map.y_label, 16, AlignX::left);
 
   // Colour bar: top = highest value.
   const int bar_x = left + plot_w + bar_gap;
@@ -97,14 +105,13 @@ void write_heatmap_png(const Heatmap& map, const std::filesystem::path& path) {
     const double f = static_cast<double>(k) / (bar_ticks - 1);
     const int y = top + static_cast<int>(std::lround((1.0 - f) * (plot_h - 1)));
     canvas.rectangle(bar_x + bar_w, y, bar_x + bar_w + 5, y + 1, {0.f, 0.f, 0.f});
-    canvas.text(bar_x + bar_w + 8, y, fmt::format("{:.1f}", lo + f * (hi - lo)), 13, AlignX::Left);
+    canvas.text(bar_x + bar_w + 8, y, fmt::format("{:.1f}", lo + f * (hi - lo)), 13, AlignX::left);
   }
-  canvas.text(bar_x + bar_w / 2, top - 14, map.value_label, 16, AlignX::Center);
+  canvas.text(bar_x + bar_w / 2, top - 14, map.value_label, 16, AlignX::center);
 
   try {
     write_file_atomically(path, true, [&](const std::filesystem::path& temporary) {
-      if (!canvas.buffer().write(temporary.string(), OIIO::TypeDesc::UINT8, "png"))
-        throw UserError(fmt::format("cannot write '{}': {}", path.string(), canvas.buffer().geterror()));
+      write_picture(temporary, path, canvas.picture(), {.format = "png", .sample = image_library::SampleType::uint8});
     });
   } catch (const ImageWriteError& e) {
     throw UserError(e.what());

@@ -3,9 +3,6 @@
 #include "compositor/chart_style.hpp"
 #include "hmz_output/image_sink.hpp"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 #include <unistd.h>
 #include <algorithm>
@@ -14,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "compositor/image_library.hpp"
 #include "compositor/optics.hpp"
 
 namespace nelf {
@@ -54,8 +52,7 @@ std::string tick_label(double value, double step) {
   return fmt::format("{:.{}f}", value, std::max(decimals, 0));
 }
 
-// An RGB raster in floating point; the picture is drawn here and handed to OpenImageIO for the text
-// and the file.
+// An RGB raster in floating point; the picture is drawn here, the text by OpenImageIO onto it.
 class Canvas {
  public:
   Canvas(int width, int height) : width_(width), height_(height), pixels_(std::size_t(width) * height * 3, 1.f) {}
@@ -98,10 +95,15 @@ class Canvas {
       for (int x = int(cx - radius - width); x <= int(cx + radius + width) + 1; ++x)
         if (std::abs(std::hypot(x - cx, y - cy) - radius) <= width / 2) set(x, y, c);
   }
-  OIIO::ImageBuf to_image() const {
-    OIIO::ImageBuf buf(OIIO::ImageSpec(width_, height_, 3, OIIO::TypeDesc::FLOAT));
-    buf.set_pixels(OIIO::ROI(0, width_, 0, height_, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT, pixels_.data());
-    return buf;
+  Rgb get(int x, int y) const {
+    const float* p = &pixels_[offset(x, y)];
+    return {p[0], p[1], p[2]};
+  }
+  image_library::Canvas raster() {
+    return {.values = pixels_.data(), .width = width_, .height = height_, .channels = 3};
+  }
+  image_library::Picture picture() const {
+    return {.values = pixels_.data(), .width = width_, .height = height_, .channels = 3, .pixel_stride = 3};
   }
 
  private:
@@ -114,24 +116,29 @@ class Canvas {
 // says what to install, not a picture without labels.
 class TextPainter {
  public:
-  TextPainter(OIIO::ImageBuf& image, std::string font) : image_(image), font_(std::move(font)) {}
-  void draw(int x, int y, const std::string& text, int size, Rgb colour = kBlack,
-            OIIO::ImageBufAlgo::TextAlignX align_x = OIIO::ImageBufAlgo::TextAlignX::Left,
-            OIIO::ImageBufAlgo::TextAlignY align_y = OIIO::ImageBufAlgo::TextAlignY::Baseline, int shadow = 0) {
-    if (!OIIO::ImageBufAlgo::render_text(image_, x, y, text, size, font_, colour, align_x, align_y, shadow))
-      fail(image_.geterror());
+  using AlignX = image_library::AlignX;
+  using AlignY = image_library::AlignY;
+  TextPainter(Canvas& canvas, std::string font) : canvas_(canvas), font_(std::move(font)) {}
+  void draw(int x, int y, const std::string& text, int size, Rgb colour = kBlack, AlignX align_x = AlignX::left,
+            AlignY align_y = AlignY::baseline, int shadow = 0) {
+    try {
+      image_library::render_text(canvas_.raster(), x, y, text, size, font_, colour, align_x, align_y, shadow);
+    } catch (const image_library::ImageLibraryError& e) {
+      fail(e.what());
+    }
   }
-  // Text running upwards (the y-axis label), centred on (cx, cy).
+  // Text running upwards (the y-axis label), centred on (cx, cy): drawn level on a label of its
+  // own, then copied in turned a quarter anticlockwise.
   void draw_vertical(int cx, int cy, const std::string& text, int size) {
-    const OIIO::ROI box = OIIO::ImageBufAlgo::text_size(text, size, font_);
-    if (!box.defined()) fail("cannot measure text");
-    const int w = box.width() + 8, h = box.height() + 8;
-    OIIO::ImageBuf label(OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::FLOAT));
-    OIIO::ImageBufAlgo::fill(label, kWhite);
-    if (!OIIO::ImageBufAlgo::render_text(label, 4 - box.xbegin, 4 - box.ybegin, text, size, font_, kBlack))
-      fail(label.geterror());
-    const OIIO::ImageBuf rotated = OIIO::ImageBufAlgo::rotate270(label);
-    if (!OIIO::ImageBufAlgo::paste(image_, cx - h / 2, cy - w / 2, 0, 0, rotated)) fail(image_.geterror());
+    const auto box = image_library::text_size(text, size, font_);
+    if (!box) fail("cannot measure text");
+    const int w = box->width() + 8, h = box->height() + 8;
+    Canvas label(w, h);
+    TextPainter(label, font_).draw(4 - box->x_begin, 4 - box->y_begin, text, size, kBlack);
+    // The label's pixel (x, y) lands at (x0 + y, y0 + w - 1 - x).
+    const int x0 = cx - h / 2, y0 = cy - w / 2;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) canvas_.set(x0 + y, y0 + w - 1 - x, label.get(x, y));
   }
 
  private:
@@ -139,7 +146,7 @@ class TextPainter {
     throw PlotError(fmt::format("cannot draw the plot's text with font '{}' (install fonts-dejavu-core): {}", font_,
                                 why.empty() ? "unknown OpenImageIO error" : why));
   }
-  OIIO::ImageBuf& image_;
+  Canvas& canvas_;
   std::string font_;
 };
 
@@ -150,7 +157,7 @@ struct Axis {
   double from_pixel(double p) const { return lo + (p - pixel_lo) / (pixel_hi - pixel_lo) * (hi - lo); }
 };
 
-OIIO::ImageBuf draw_plot(const Profile& profile) {
+Canvas draw_plot(const Profile& profile) {
   constexpr int width = 1100, height = 820;
   constexpr int left = 110, right = 900, top = 96, bottom = 720;  // the plot area
   constexpr int bar_left = 940, bar_right = 970;                  // the colour bar
@@ -241,10 +248,9 @@ OIIO::ImageBuf draw_plot(const Profile& profile) {
     canvas.line(mark_x, mark_y - 15, mark_x, mark_y + 15, kWhite, 2);
   }
 
-  OIIO::ImageBuf image = canvas.to_image();
-  using OIIO::ImageBufAlgo::TextAlignX;
-  using OIIO::ImageBufAlgo::TextAlignY;
-  TextPainter text(image, chart::font());
+  using TextAlignX = TextPainter::AlignX;
+  using TextAlignY = TextPainter::AlignY;
+  TextPainter text(canvas, chart::font());
   const std::string name = profile.name.empty() ? std::string("profile") : profile.name;
   text.draw(left, 40, fmt::format("Spatial resolution N_p (Eq. 8, horizontal) over the lens design space: {}", name),
             22);
@@ -255,19 +261,19 @@ OIIO::ImageBuf draw_plot(const Profile& profile) {
                         profile.viewing.eye_relief_mm, profile.viewing.virtual_image_mm),
             15, {0.2f, 0.2f, 0.2f});
   for (const auto& [px, label] : x_ticks)
-    text.draw(px, bottom + 12, label, 16, kBlack, TextAlignX::Center, TextAlignY::Top);
+    text.draw(px, bottom + 12, label, 16, kBlack, TextAlignX::center, TextAlignY::top);
   for (const auto& [py, label] : y_ticks)
-    text.draw(left - 13, py, label, 16, kBlack, TextAlignX::Right, TextAlignY::Center);
+    text.draw(left - 13, py, label, 16, kBlack, TextAlignX::right, TextAlignY::center);
   for (const auto& [py, label] : bar_ticks)
-    text.draw(bar_right + 10, py, label, 16, kBlack, TextAlignX::Left, TextAlignY::Center);
-  text.draw((left + right) / 2, bottom + 58, "lens focal length f (mm)", 20, kBlack, TextAlignX::Center,
-            TextAlignY::Baseline);
+    text.draw(bar_right + 10, py, label, 16, kBlack, TextAlignX::left, TextAlignY::center);
+  text.draw((left + right) / 2, bottom + 58, "lens focal length f (mm)", 20, kBlack, TextAlignX::center,
+            TextAlignY::baseline);
   text.draw_vertical(left - 72, (top + bottom) / 2, "lens pitch w_l (mm)", 20);
   text.draw_vertical(bar_right + 70, (top + bottom) / 2, "spatial resolution N_p (px)", 18);
 
   // Label the hatched region inside it, near the top-left corner where it is widest.
-  text.draw(left + 14, top + 30, "f/w_l < 1: faster than f/1", 17, kWhite, TextAlignX::Left, TextAlignY::Baseline, 2);
-  text.draw(left + 14, top + 52, "(impractical lenses)", 15, kWhite, TextAlignX::Left, TextAlignY::Baseline, 2);
+  text.draw(left + 14, top + 30, "f/w_l < 1: faster than f/1", 17, kWhite, TextAlignX::left, TextAlignY::baseline, 2);
+  text.draw(left + 14, top + 52, "(impractical lenses)", 15, kWhite, TextAlignX::left, TextAlignY::baseline, 2);
 
   const int legend_y = height - 22;
   if (mark) {
@@ -275,10 +281,10 @@ OIIO::ImageBuf draw_plot(const Profile& profile) {
     const std::string label = fmt::format("{}: f {:.4g} mm, w_l {:.4g} mm, N_p {} px", name,
                                           profile.lens_array->focal_length_mm, profile.lens_array->pitch_mm, n);
     // Right of the mark unless that would leave the plot area.
-    const auto box = OIIO::ImageBufAlgo::text_size(label, 17, chart::font());
-    const bool flip = mark_x + 22 + box.width() > right;
+    const auto box = image_library::text_size(label, 17, chart::font());
+    const bool flip = mark_x + 22 + (box ? box->width() : 0) > right;
     text.draw(static_cast<int>(mark_x) + (flip ? -22 : 22), static_cast<int>(mark_y) - 14, label, 17, kWhite,
-              flip ? TextAlignX::Right : TextAlignX::Left, TextAlignY::Bottom, 2);
+              flip ? TextAlignX::right : TextAlignX::left, TextAlignY::bottom, 2);
     text.draw(left, legend_y,
               "Marked: this profile's lens array. Hatched: f-number below 1. Bands: steps in the number of "
               "lenses used N_l (Eq. 6).",
@@ -290,7 +296,7 @@ OIIO::ImageBuf draw_plot(const Profile& profile) {
                     name),
         14, {0.2f, 0.2f, 0.2f});
   }
-  return image;
+  return canvas;
 }
 
 }  // namespace
@@ -306,27 +312,25 @@ void write_trade_space_plot(const Profile& profile, const std::filesystem::path&
     throw PlotError(fmt::format("cannot write plot {}: it is a directory", path.string()));
 
   // Ask for a writer before drawing, so that an unknown extension is reported by its own name.
-  if (!OIIO::ImageOutput::create(path.string())) {
-    OIIO::geterror();  // clear OpenImageIO's pending message: ours replaces it
+  bool writable = false;
+  try {
+    writable = image_library::has_writer(path.string());
+  } catch (const image_library::ImageLibraryError& e) {
+    throw PlotError(fmt::format("cannot write plot {}: {}", path.string(), e.what()));
+  }
+  if (!writable) {
     throw PlotError(fmt::format("cannot write plot {}: no image format for extension '{}' (use .png)", path.string(),
                                 path.extension().string()));
   }
 
-  const OIIO::ImageBuf image = draw_plot(profile);
+  const Canvas image = draw_plot(profile);
 
   // The format comes from the final name: the temporary file has no extension.
   std::string format = path.extension().string().substr(1);
   std::transform(format.begin(), format.end(), format.begin(), [](unsigned char c) { return std::tolower(c); });
   try {
     write_file_atomically(path, true, [&](const fs::path& temporary) {
-      if (!image.write(temporary.string(), OIIO::TypeDesc::UINT8, format)) {
-        std::string why = image.geterror();
-        if (why.empty()) why = OIIO::geterror();  // format lookups report through the global error
-        if (why.empty()) why = "OpenImageIO could not write it";
-        // OpenImageIO's messages can span lines; the user gets one.
-        std::replace(why.begin(), why.end(), '\n', ' ');
-        throw PlotError(fmt::format("cannot write plot {}: {}", path.string(), why));
-      }
+      write_picture(temporary, path, image.picture(), {.format = format, .sample = image_library::SampleType::uint8});
     });
   } catch (const ImageWriteError& e) {
     throw PlotError(fmt::format("plot: {}", e.what()));

@@ -1,7 +1,5 @@
 #include "compositor/text_overlay.hpp"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -11,6 +9,7 @@
 
 #include "compositor/chart_style.hpp"
 #include "compositor/gl/egl_context.hpp"
+#include "compositor/image_library.hpp"
 
 namespace nelf {
 
@@ -55,24 +54,29 @@ void TextOverlay::set_text(std::string text) { text_ = std::move(text); }
 const TextOverlay::Label& TextOverlay::label(int font_px) {
   if (label_.texture && label_.text == text_ && label_.font_px == font_px) return label_;
   const std::string font = chart::font();
-  const OIIO::ROI extent = OIIO::ImageBufAlgo::text_size(text_, font_px, font);
-  if (!extent.defined())
+  const auto extent = image_library::text_size(text_, font_px, font);
+  if (!extent)
     throw std::runtime_error(
         fmt::format("cannot render the on-screen text with font {} (install fonts-dejavu-core)", font));
   // A fixed line height from the font size, so that the box does not jump as descenders come and go.
   const int pad = std::max(2, font_px / 3);
-  const int ascent = std::max(static_cast<int>(std::lround(0.95 * font_px)), -extent.ybegin);
-  const int descent = std::max(static_cast<int>(std::lround(0.25 * font_px)), extent.yend);
-  const int width = extent.width() + 2 * pad, height = ascent + descent + 2 * pad;
+  const int ascent = std::max(static_cast<int>(std::lround(0.95 * font_px)), -extent->y_begin);
+  const int descent = std::max(static_cast<int>(std::lround(0.25 * font_px)), extent->y_end);
+  const int width = extent->width() + 2 * pad, height = ascent + descent + 2 * pad;
 
-  OIIO::ImageBuf image(OIIO::ImageSpec(width, height, 4, OIIO::TypeDesc::FLOAT));
-  const float box[4] = {0.f, 0.f, 0.f, kBoxOpacity}, white[4] = {1.f, 1.f, 1.f, 1.f};
-  if (!OIIO::ImageBufAlgo::fill(image, box) ||
-      !OIIO::ImageBufAlgo::render_text(image, pad - extent.xbegin, pad + ascent, text_, font_px, font, white))
-    throw std::runtime_error("cannot render the on-screen text: " + image.geterror());
-  std::vector<unsigned char> pixels(static_cast<std::size_t>(width) * height * 4);
-  if (!image.get_pixels(OIIO::ROI(0, width, 0, height, 0, 1, 0, 4), OIIO::TypeDesc::UINT8, pixels.data()))
-    throw std::runtime_error("cannot read the on-screen text: " + image.geterror());
+  // White text on a translucent black box, drawn as float and stored as RGBA8.
+  std::vector<float> image(static_cast<std::size_t>(width) * height * 4);
+  for (std::size_t i = 0; i < image.size(); i += 4) image[i + 3] = kBoxOpacity;
+  const float white[4] = {1.f, 1.f, 1.f, 1.f};
+  try {
+    image_library::render_text({.values = image.data(), .width = width, .height = height, .channels = 4},
+                               pad - extent->x_begin, pad + ascent, text_, font_px, font, white);
+  } catch (const image_library::ImageLibraryError& e) {
+    throw std::runtime_error(fmt::format("cannot render the on-screen text: {}", e.what()));
+  }
+  std::vector<unsigned char> pixels(image.size());
+  for (std::size_t i = 0; i < image.size(); ++i)
+    pixels[i] = static_cast<unsigned char>(std::lround(std::clamp(image[i], 0.f, 1.f) * 255.f));
 
   label_.texture = gl::make_texture_2d(GL_RGBA8, width, height);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);

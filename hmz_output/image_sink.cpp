@@ -1,7 +1,5 @@
 #include "hmz_output/image_sink.hpp"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <pthread.h>
@@ -17,6 +15,8 @@
 #include <string>
 #include <system_error>
 #include <vector>
+
+#include "compositor/image_library.hpp"
 
 namespace nelf {
 namespace {
@@ -189,29 +189,28 @@ void write_image_file(const Image& image, const fs::path& path, const ImageWrite
                                       path.string(), image.width(), image.height(), kMaxJpegDimension));
 
   write_file_atomically(path, options.overwrite, [&](const fs::path& temporary) {
-    OIIO::TypeDesc pixel_type = options.bits == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8;
-    if (format == FileFormat::exr) pixel_type = OIIO::TypeDesc::HALF;
-    OIIO::ImageSpec spec(image.width(), image.height(), 3, pixel_type);
-    if (format == FileFormat::jpeg) spec.attribute("CompressionQuality", 95);
-
-    auto out = OIIO::ImageOutput::create(oiio_format_name(format));
-    if (!out)
-      throw ImageWriteError(
-          fmt::format("cannot write {}: no {} writer ({})", path.string(), oiio_format_name(format), OIIO::geterror()));
-    // OIIO's writers (PNG at least) ignore failed writes, so a full disk would leave a truncated
-    // image and no error: encode into memory where the writer can, and write the bytes here.
-    OIIO::Filesystem::IOVecOutput encoded;
-    const bool in_memory = out->supports("ioproxy") != 0 && out->set_ioproxy(&encoded);
-    if (!out->open(temporary.string(), spec))
-      throw ImageWriteError(fmt::format("cannot write {}: {}", path.string(), out->geterror()));
+    image_library::EncodeOptions encode{
+        .format = oiio_format_name(format),
+        .sample = options.bits == 16 ? image_library::SampleType::uint16 : image_library::SampleType::uint8,
+        .jpeg_quality = 95};
+    if (format == FileFormat::exr) encode.sample = image_library::SampleType::half;
     // RGB out of the RGBA floats: a pixel stride of four floats skips alpha.
-    const auto pixel_stride = static_cast<OIIO::stride_t>(sizeof(Rgba));
-    const bool written =
-        out->write_image(OIIO::TypeDesc::FLOAT, image.data(), pixel_stride, pixel_stride * image.width());
-    const bool closed = out->close();
-    if (!written || !closed) throw ImageWriteError(fmt::format("cannot write {}: {}", path.string(), out->geterror()));
-    if (in_memory) write_bytes(temporary, encoded.buffer(), path);
+    write_picture(
+        temporary, path,
+        {.values = image.data(), .width = image.width(), .height = image.height(), .channels = 3, .pixel_stride = 4},
+        encode);
   });
+}
+
+void write_picture(const fs::path& temporary, const fs::path& shown, const image_library::Picture& picture,
+                   const image_library::EncodeOptions& options) {
+  std::optional<std::vector<unsigned char>> encoded;
+  try {
+    encoded = image_library::encode(picture, options, temporary.string());
+  } catch (const image_library::ImageLibraryError& e) {
+    throw ImageWriteError(fmt::format("cannot write {}: {}", shown.string(), e.what()));
+  }
+  if (encoded) write_bytes(temporary, *encoded, shown);
 }
 
 void write_file_atomically(const fs::path& path, bool overwrite, const std::function<void(const fs::path&)>& write) {

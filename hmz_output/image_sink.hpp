@@ -1,12 +1,13 @@
 #pragma once
-// The image-file sink: writes one output frame with OpenImageIO, format by extension (.png, .tif,
-// .tiff, .exr, .jpg, .jpeg). The file appears complete or not at all: it is written under a
-// temporary name in the same directory and renamed at the end (DESIGN.md §11).
+// The image-file sink: writes one output frame with OpenImageIO (compositor/image_library.hpp), format by extension
+// (.png, .tif, .tiff, .exr, .jpg, .jpeg). The file appears complete or not at all: it is written under a temporary name
+// in the same directory and renamed at the end (DESIGN.md §11).
 #include <filesystem>
 #include <functional>
 #include <stdexcept>
 
 #include "compositor/image.hpp"
+#include "compositor/image_library.hpp"
 
 namespace nelf {
 
@@ -30,6 +31,11 @@ void check_image_writable(const std::filesystem::path& path, const ImageWriteOpt
 // clamped to 0..1 for integer formats. On any failure the temporary file is removed and nothing
 // appears at `path`.
 void write_image_file(const Image& image, const std::filesystem::path& path, const ImageWriteOptions& options);
+
+// Encodes `picture` into the file `temporary` with every write checked (a full disk is an error,
+// not a truncated image). Messages name `shown`, the file the user asked for.
+void write_picture(const std::filesystem::path& temporary, const std::filesystem::path& shown,
+                   const image_library::Picture& picture, const image_library::EncodeOptions& options);
 
 // Any file written without a half-written state: `write` fills a temporary file beside `path`
 // (a hidden name without the extension: name the format explicitly), which is then renamed into

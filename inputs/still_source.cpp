@@ -1,7 +1,5 @@
 #include "inputs/still_source.hpp"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <unistd.h>
@@ -16,6 +14,8 @@
 #include <system_error>
 #include <vector>
 
+#include "compositor/image_library.hpp"
+
 namespace nelf {
 namespace {
 
@@ -27,32 +27,11 @@ std::string lowercase_extension(const fs::path& path) {
   return ext;
 }
 
-// OIIO messages can span lines and repeat the file name; keep the first line, which says why.
-std::string first_line(std::string message) {
-  const auto newline = message.find('\n');
-  if (newline != std::string::npos) message.resize(newline);
-  if (message.empty()) message = "unknown error";
-  return message;
-}
-
-// Reads the first subimage of an opened input into float RGBA, validating its size first so that a
-// header claiming absurd dimensions never gets an allocation.
-Image read_opened(OIIO::ImageInput& input, const std::string& name) {
-  const OIIO::ImageSpec& spec = input.spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
-    throw StillError(
-        fmt::format("{}: the image has no pixels ({}x{}, {} channels)", name, spec.width, spec.height, spec.nchannels));
-  if (spec.width > kMaxImageDimension || spec.height > kMaxImageDimension)
-    throw StillError(fmt::format("{}: {}x{} is too large (at most {} pixels per side)", name, spec.width, spec.height,
-                                 kMaxImageDimension));
-  if (spec.depth > 1) throw StillError(fmt::format("{}: volume images are not supported", name));
-  const int channels = std::min(spec.nchannels, 4);
-  std::vector<float> buffer(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height) *
-                            static_cast<std::size_t>(channels));
-  if (!input.read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, buffer.data()))
-    throw StillError(fmt::format("{}: cannot read the image: {}", name, first_line(input.geterror())));
-  Image image(spec.width, spec.height);
-  const float* src = buffer.data();
+// Float RGBA from what the image library read (one to four channels).
+Image to_rgba(const image_library::Pixels& pixels) {
+  Image image(pixels.width, pixels.height);
+  const float* src = pixels.values.data();
+  const int channels = pixels.channels;
   for (Rgba& px : image.pixels()) {
     switch (channels) {
       case 1:
@@ -294,40 +273,24 @@ std::vector<std::size_t> find_mpo_images(std::span<const std::byte> bytes) {
 }
 
 Image decode_image(std::span<const std::byte> encoded, const std::string& format, const std::string& name) {
-  OIIO::Filesystem::IOMemReader reader(encoded.data(), encoded.size());
-  auto input = OIIO::ImageInput::create(format, false, nullptr, &reader);
-  if (!input) throw StillError(fmt::format("{}: no {} reader ({})", name, format, first_line(OIIO::geterror())));
-  // The reader reads from the proxy handed over in the open configuration, not from a file.
-  OIIO::ImageSpec config;
-  OIIO::Filesystem::IOProxy* proxy = &reader;
-  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-  OIIO::ImageSpec spec;
-  if (!input->open(name, spec, config))
-    throw StillError(fmt::format("{}: cannot read the image: {}", name, first_line(input->geterror())));
-  Image image = read_opened(*input, name);
-  input->close();
-  return image;
+  try {
+    return to_rgba(image_library::decode(encoded, format, name, kMaxImageDimension));
+  } catch (const image_library::ImageLibraryError& e) {
+    throw StillError(e.what());
+  }
 }
 
 Image read_image_file(const fs::path& path) {
   require_file(path);
-  const std::string name = path.string();
   std::optional<SilencedStderr> silence_libpng;
   if (has_png_signature(path)) silence_libpng.emplace();
-  std::unique_ptr<OIIO::ImageInput> input;
-  if (lowercase_extension(path) == ".jps") {
-    // OIIO does not know the .jps extension; a JPS file is a JPEG.
-    input = OIIO::ImageInput::create("jpeg");
-    OIIO::ImageSpec spec;
-    if (input && !input->open(name, spec))
-      throw StillError(fmt::format("{}: cannot read the image: {}", name, first_line(input->geterror())));
-  } else {
-    input = OIIO::ImageInput::open(name);
+  // OIIO does not know the .jps extension; a JPS file is a JPEG.
+  const std::string format = lowercase_extension(path) == ".jps" ? "jpeg" : "";
+  try {
+    return to_rgba(image_library::read_file(path.string(), format, kMaxImageDimension));
+  } catch (const image_library::ImageLibraryError& e) {
+    throw StillError(e.what());
   }
-  if (!input) throw StillError(fmt::format("{}: cannot read the image: {}", name, first_line(OIIO::geterror())));
-  Image image = read_opened(*input, name);
-  input->close();
-  return image;
 }
 
 StillStereo load_still(const fs::path& path, const StillOptions& options) {

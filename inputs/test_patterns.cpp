@@ -1,7 +1,5 @@
 #include "inputs/test_patterns.hpp"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -10,6 +8,7 @@
 #include <numbers>
 
 #include "compositor/chart_style.hpp"
+#include "compositor/image_library.hpp"
 #include "compositor/mapping.hpp"
 #include "compositor/optics.hpp"
 
@@ -39,32 +38,37 @@ void fill_rect(Image& image, int x0, int y0, int x1, int y1, Rgba colour) {
 class TextCanvas {
  public:
   TextCanvas(int width, int height)
-      : buffer_(OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT)), font_(chart::font()) {
-    OIIO::ImageBufAlgo::zero(buffer_);
-    const OIIO::ROI h = OIIO::ImageBufAlgo::text_size("H", kProbeSize, font_);
-    if (!h.defined() || h.height() <= 0) fail("cannot measure text");
-    cap_per_em_ = static_cast<double>(h.height()) / kProbeSize;
+      : width_(width),
+        buffer_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)),
+        font_(chart::font()) {
+    const auto h = image_library::text_size("H", kProbeSize, font_);
+    if (!h || h->height() <= 0) fail("cannot measure text");
+    cap_per_em_ = static_cast<double>(h->height()) / kProbeSize;
   }
 
   // Draws `text` with its cap height `cap_px`, top edge at `top`, centred on `x` or starting there.
   void draw(double x, int top, const std::string& text, double cap_px, bool centred) {
     const int size = std::max(1, static_cast<int>(std::lround(cap_px / cap_per_em_)));
-    const float colour[3] = {1.f, 1.f, 1.f};
-    using AlignX = OIIO::ImageBufAlgo::TextAlignX;
-    if (!OIIO::ImageBufAlgo::render_text(buffer_, static_cast<int>(std::lround(x)), top, text, size, font_, colour,
-                                         centred ? AlignX::Center : AlignX::Left, OIIO::ImageBufAlgo::TextAlignY::Top))
-      fail(buffer_.geterror());
+    const float coverage[1] = {1.f};
+    using image_library::AlignX;
+    try {
+      image_library::render_text({.values = buffer_.data(),
+                                  .width = width_,
+                                  .height = static_cast<int>(buffer_.size() / static_cast<std::size_t>(width_)),
+                                  .channels = 1},
+                                 static_cast<int>(std::lround(x)), top, text, size, font_, coverage,
+                                 centred ? AlignX::center : AlignX::left, image_library::AlignY::top);
+    } catch (const image_library::ImageLibraryError& e) {
+      fail(e.what());
+    }
   }
 
-  // Adds the drawn text (white, antialiased) onto `image` in `colour`.
+  // Adds the drawn text (antialiased) onto `image` in `colour`.
   void composite_onto(Image& image, Rgba colour) const {
-    std::vector<float> rgb(static_cast<std::size_t>(image.width()) * static_cast<std::size_t>(image.height()) * 3);
-    buffer_.get_pixels(OIIO::ROI(0, image.width(), 0, image.height(), 0, 1, 0, 3), OIIO::TypeDesc::FLOAT, rgb.data());
     for (int y = 0; y < image.height(); ++y)
       for (int x = 0; x < image.width(); ++x) {
         const float a =
-            rgb[(static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width()) + static_cast<std::size_t>(x)) *
-                3];
+            buffer_[static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x)];
         if (a <= 0.f) continue;
         Rgba& p = image.at(x, y);
         p.r = p.r * (1.f - a) + colour.r * a;
@@ -79,7 +83,8 @@ class TextCanvas {
     throw TestPatternError(fmt::format("cannot draw the pattern's text with font '{}' (install fonts-dejavu-core): {}",
                                        font_, why.empty() ? "unknown OpenImageIO error" : why));
   }
-  OIIO::ImageBuf buffer_;
+  int width_;
+  std::vector<float> buffer_;  // the text's coverage, one float a pixel
   std::string font_;
   double cap_per_em_ = 0.73;
 };
