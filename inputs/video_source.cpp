@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "inputs/ffmpeg_raii.hpp"
+#include "inputs/yuv_block_means.hpp"
 
 extern "C" {
 #include <libavutil/display.h>
@@ -457,6 +458,27 @@ struct VideoSource::Impl {
     const ReducedRegion& size = regions.front();
     const int out_w = size.width / size.block_x, out_h = size.height / size.block_y;
     const AVPixelFormat target = bits_of(source_format) > 8 ? AV_PIX_FMT_RGBA64 : AV_PIX_FMT_RGBA;
+    if (source_format == AV_PIX_FMT_YUV420P && yuv420_block_means_supported(size.block_x, size.block_y)) {
+      // Most video: block means of 8-bit 4:2:0 without swscale (inputs/yuv_block_means.hpp).
+      const YuvToRgb matrix = yuv_to_rgb_from_sws(sws_getCoefficients(colorspace), full_range);
+      for (const ReducedRegion& r : regions) {
+        if (r.x + r.width > decoded.width || r.y + r.height > decoded.height)
+          fail(fmt::format("the frame size changed mid-stream ({}x{})", decoded.width, decoded.height));
+        const Yuv420Planes planes{
+            .y = decoded.data[0] + static_cast<std::ptrdiff_t>(r.y) * decoded.linesize[0] + r.x,
+            .u = decoded.data[1] + static_cast<std::ptrdiff_t>(r.y / 2) * decoded.linesize[1] + r.x / 2,
+            .v = decoded.data[2] + static_cast<std::ptrdiff_t>(r.y / 2) * decoded.linesize[2] + r.x / 2,
+            .y_stride = decoded.linesize[0],
+            .u_stride = decoded.linesize[1],
+            .v_stride = decoded.linesize[2]};
+        std::vector<std::uint8_t> pixels(static_cast<std::size_t>(out_w) * static_cast<std::size_t>(out_h) * 4);
+        yuv420_block_means(planes, r.width, r.height, r.block_x, r.block_y, matrix, pixels.data(),
+                           static_cast<std::size_t>(out_w) * 4);
+        out.reduced.push_back(std::move(pixels));
+      }
+      out.bits = 8;
+      return;
+    }
     if (!reduce_sws || reduce_format != source_format || reduce_colorspace != colorspace ||
         reduce_full_range != static_cast<int>(full_range)) {
       // SWS_AREA at a whole-number ratio weighs the pixels of each block equally (the prefilter's
