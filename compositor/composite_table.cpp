@@ -280,7 +280,9 @@ CompositeTable::CompositeTable(Built built) : built_(std::move(built)) {
   if (!size_fits(panel) || !size_fits(reduced) || !size_fits(prefiltered) ||
       taps.size() != static_cast<std::size_t>(panel[0]) * panel[1] ||
       !axis_fits(horizontal, prefiltered[0], reduced[0]) || !axis_fits(vertical, prefiltered[1], reduced[1]) ||
-      !std::all_of(taps.begin(), taps.end(), tap_fits) || !std::all_of(borders.begin(), borders.end(), border_fits))
+      !std::all_of(taps.begin(), taps.end(), tap_fits) || !std::all_of(borders.begin(), borders.end(), border_fits) ||
+      !std::is_sorted(borders.begin(), borders.end(),
+                      [](const BorderPixel& a, const BorderPixel& b) { return a.y < b.y; }))
     throw std::invalid_argument("CompositeTable: the table is inconsistent");
 
   // The box pass in fixed point. Along x every output sample takes the same number of cell pairs
@@ -463,6 +465,43 @@ void box_row_down(const std::uint8_t* rows, std::size_t row, const std::int16_t*
 }
 #endif
 
+// Pass 2 for one border pixel: each part of the aperture through its lens (its tap), weighted by
+// its area, in float, into `out`.
+void border_pixel(const CompositeTable::BorderPixel& b, const std::uint8_t* image, std::size_t image_row,
+                  std::uint8_t* out) {
+#if defined(__SSE2__)
+  // The same arithmetic as below, branch-free: a part without weight adds 0 × its (finite) tap.
+  const __m128i zero = _mm_setzero_si128();
+  const auto pair_weights = [](const CompositeTable::Tap* taps) {  // [a, b, a, b], as in replay_taps
+    return _mm_shuffle_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(taps)), _MM_SHUFFLE(3, 1, 3, 1));
+  };
+  const auto at = [&](int k) { return image + 4 * static_cast<std::size_t>(b.taps[k].texel); };
+  const __m128i sum01 = bilinear_pair(at(0), at(1), image_row, pair_weights(&b.taps[0]));
+  const __m128i sum23 = bilinear_pair(at(2), at(3), image_row, pair_weights(&b.taps[2]));
+  const __m128 parts = _mm_loadu_ps(b.weights.data());
+  // weight / 256 is exact, so × (1/256) is the same.
+  const __m128 w = _mm_mul_ps(_mm_and_ps(_mm_cmpgt_ps(parts, _mm_setzero_ps()), parts), _mm_set1_ps(1.f / 256.f));
+  __m128 sum = _mm_mul_ps(_mm_shuffle_ps(w, w, 0x00), _mm_cvtepi32_ps(_mm_unpacklo_epi16(sum01, zero)));
+  sum = _mm_add_ps(sum, _mm_mul_ps(_mm_shuffle_ps(w, w, 0x55), _mm_cvtepi32_ps(_mm_unpackhi_epi16(sum01, zero))));
+  sum = _mm_add_ps(sum, _mm_mul_ps(_mm_shuffle_ps(w, w, 0xaa), _mm_cvtepi32_ps(_mm_unpacklo_epi16(sum23, zero))));
+  sum = _mm_add_ps(sum, _mm_mul_ps(_mm_shuffle_ps(w, w, 0xff), _mm_cvtepi32_ps(_mm_unpackhi_epi16(sum23, zero))));
+  // store_unorm8: clamped, + ½, truncated; alpha 255.
+  sum = _mm_min_ps(_mm_max_ps(sum, _mm_setzero_ps()), _mm_set1_ps(255.f));
+  const __m128i codes = _mm_cvttps_epi32(_mm_add_ps(sum, _mm_set1_ps(0.5f)));
+  const __m128i bytes = _mm_packus_epi16(_mm_packs_epi32(codes, codes), zero);
+  const std::uint32_t pixel = static_cast<std::uint32_t>(_mm_cvtsi128_si32(bytes)) | 0xff000000u;
+  std::memcpy(out, &pixel, 4);
+#else
+  F32x4 sum = {0.f, 0.f, 0.f, 0.f};
+  for (int k = 0; k < 4; ++k) {
+    if (b.weights[k] <= 0.f) continue;
+    const U16x4 v = bilinear(image + 4 * static_cast<std::size_t>(b.taps[k].texel), image_row, tap_weights(b.taps[k]));
+    sum += (b.weights[k] / 256.f) * __builtin_convertvector(v, F32x4);
+  }
+  store_unorm8(out, sum);
+#endif
+}
+
 }  // namespace
 
 // The prefilter's box pass in fixed point: weights in 1/32768 (fixed_weights: each within a
@@ -513,51 +552,18 @@ void CompositeTable::render(const std::uint8_t* reduced, std::size_t reduced_str
                             std::size_t out_stride) {
   box_pass(reduced, reduced_stride);
 
-  // Pass 1: one bilinear tap per pixel.
+  // Pass 1, one bilinear tap per pixel, a row at a time; then pass 2 for the row's pixels along the
+  // elemental-image borders (sorted by row) while the row is still in the cache.
   const std::uint8_t* image = image_.data();
   const std::size_t image_row = static_cast<std::size_t>(built_.prefiltered[0]) * 4;
   const int width = built_.panel[0];
-  for (int y = 0; y < built_.panel[1]; ++y)
-    replay_taps(&built_.taps[static_cast<std::size_t>(y) * width], width, image, image_row,
-                out + static_cast<std::size_t>(y) * out_stride);
-
-    // Pass 2: the pixels along the elemental-image borders, each part of the aperture through its lens.
-#if defined(__SSE2__)
-  // The same arithmetic as below, branch-free: a part without weight adds 0 × its (finite) tap.
-  const __m128i zero = _mm_setzero_si128();
-  for (const BorderPixel& b : built_.borders) {
-    const auto pair_weights = [](const Tap* taps) {  // [a, b, a, b], as in replay_taps
-      return _mm_shuffle_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(taps)), _MM_SHUFFLE(3, 1, 3, 1));
-    };
-    const auto at = [&](int k) { return image + 4 * static_cast<std::size_t>(b.taps[k].texel); };
-    const __m128i sum01 = bilinear_pair(at(0), at(1), image_row, pair_weights(&b.taps[0]));
-    const __m128i sum23 = bilinear_pair(at(2), at(3), image_row, pair_weights(&b.taps[2]));
-    const __m128 parts = _mm_loadu_ps(b.weights.data());
-    // weight / 256 is exact, so × (1/256) is the same.
-    const __m128 w = _mm_mul_ps(_mm_and_ps(_mm_cmpgt_ps(parts, _mm_setzero_ps()), parts), _mm_set1_ps(1.f / 256.f));
-    __m128 sum = _mm_mul_ps(_mm_shuffle_ps(w, w, 0x00), _mm_cvtepi32_ps(_mm_unpacklo_epi16(sum01, zero)));
-    sum = _mm_add_ps(sum, _mm_mul_ps(_mm_shuffle_ps(w, w, 0x55), _mm_cvtepi32_ps(_mm_unpackhi_epi16(sum01, zero))));
-    sum = _mm_add_ps(sum, _mm_mul_ps(_mm_shuffle_ps(w, w, 0xaa), _mm_cvtepi32_ps(_mm_unpacklo_epi16(sum23, zero))));
-    sum = _mm_add_ps(sum, _mm_mul_ps(_mm_shuffle_ps(w, w, 0xff), _mm_cvtepi32_ps(_mm_unpackhi_epi16(sum23, zero))));
-    // store_unorm8: clamped, + ½, truncated; alpha 255.
-    sum = _mm_min_ps(_mm_max_ps(sum, _mm_setzero_ps()), _mm_set1_ps(255.f));
-    const __m128i codes = _mm_cvttps_epi32(_mm_add_ps(sum, _mm_set1_ps(0.5f)));
-    const __m128i bytes = _mm_packus_epi16(_mm_packs_epi32(codes, codes), zero);
-    const std::uint32_t pixel = static_cast<std::uint32_t>(_mm_cvtsi128_si32(bytes)) | 0xff000000u;
-    std::memcpy(out + static_cast<std::size_t>(b.y) * out_stride + 4 * static_cast<std::size_t>(b.x), &pixel, 4);
+  auto border = built_.borders.begin();
+  for (int y = 0; y < built_.panel[1]; ++y) {
+    std::uint8_t* row = out + static_cast<std::size_t>(y) * out_stride;
+    replay_taps(&built_.taps[static_cast<std::size_t>(y) * width], width, image, image_row, row);
+    for (; border != built_.borders.end() && border->y == y; ++border)
+      border_pixel(*border, image, image_row, row + 4 * static_cast<std::size_t>(border->x));
   }
-#else
-  for (const BorderPixel& b : built_.borders) {
-    F32x4 sum = {0.f, 0.f, 0.f, 0.f};
-    for (int k = 0; k < 4; ++k) {
-      if (b.weights[k] <= 0.f) continue;
-      const U16x4 v =
-          bilinear(image + 4 * static_cast<std::size_t>(b.taps[k].texel), image_row, tap_weights(b.taps[k]));
-      sum += (b.weights[k] / 256.f) * __builtin_convertvector(v, F32x4);
-    }
-    store_unorm8(out + static_cast<std::size_t>(b.y) * out_stride + 4 * static_cast<std::size_t>(b.x), sum);
-  }
-#endif
 }
 
 void render_packed_eyes(std::array<std::optional<CompositeTable>, 2>& tables,

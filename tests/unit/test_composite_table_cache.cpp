@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "compositor/composite_table_cache.hpp"
@@ -186,6 +187,9 @@ TEST(CompositeTableCache, InconsistentBuiltTablesAreRefused) {
   EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
   bad = good;
   bad.borders[1].taps[3].texel = texels * 4;  // even a part without weight
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+  bad = good;
+  std::swap(bad.borders[0], bad.borders[1]);  // render takes them row by row, in order
   EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
   bad = good;
   bad.prefiltered = {1 << 20, 3};
