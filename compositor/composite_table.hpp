@@ -72,7 +72,7 @@ class CompositeTable {
     std::array<int, 2> panel{0, 0}, reduced{0, 0}, prefiltered{0, 0};  // as in Recording
     BoxAxis horizontal, vertical;
     std::vector<Tap> taps;             // per pixel, y · panel[0] + x (pass 1)
-    std::vector<BorderPixel> borders;  // pass 2
+    std::vector<BorderPixel> borders;  // pass 2, in row order
   };
 
   explicit CompositeTable(const Recording& recording);
