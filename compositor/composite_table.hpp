@@ -52,11 +52,38 @@ class CompositeTable {
     std::vector<std::array<BorderPart, 4>> border_parts;
   };
 
-  explicit CompositeTable(const Recording& recording);
+  // One bilinear tap of the prefiltered image: its top-left texel (y · prefiltered[0] + x; the
+  // black texel is prefiltered[0] · prefiltered[1], the first of the spare rows below the image)
+  // and the weights (out of 256) of it, its right neighbour and the two below them. The weights sum
+  // to 256; all four 0 stands for 256 on the top-left texel (the only way a weight reaches 256:
+  // make_tap moves such a tap onto that texel), so a tap is 8 bytes, not 12.
+  struct Tap {
+    std::int32_t texel = 0;
+    std::array<std::uint8_t, 4> weights{};
+  };
+  struct BorderPixel {
+    std::int32_t x = 0, y = 0;  // in the panel
+    std::array<Tap, 4> taps;
+    std::array<float, 4> weights{};  // per part; ≤ 0: no part
+  };
+  // What render() replays, built from a Recording (what a CompositeTableCache keeps: a table loaded
+  // from it needs no make_tap per pixel).
+  struct Built {
+    std::array<int, 2> panel{0, 0}, reduced{0, 0}, prefiltered{0, 0};  // as in Recording
+    BoxAxis horizontal, vertical;
+    std::vector<Tap> taps;             // per pixel, y · panel[0] + x (pass 1)
+    std::vector<BorderPixel> borders;  // pass 2, in row order
+  };
 
-  std::array<int, 2> panel() const { return panel_; }
+  explicit CompositeTable(const Recording& recording);
+  // Everything that indexes memory is checked (a Built may come from a cache file); throws
+  // std::invalid_argument when it does not hold together.
+  explicit CompositeTable(Built built);
+
+  std::array<int, 2> panel() const { return built_.panel; }
   // The block-mean image render() takes (GlReducedView's texture size).
-  std::array<int, 2> reduced_size() const { return reduced_; }
+  std::array<int, 2> reduced_size() const { return built_.reduced; }
+  const Built& built() const { return built_; }
 
   // Renders the eye from `reduced` (RGBA8 block means, row 0 the top row, `reduced_stride` bytes
   // per row) into `out` (the panel-sized eye image, RGBA8, row 0 the top row, `out_stride` bytes
@@ -64,32 +91,27 @@ class CompositeTable {
   void render(const std::uint8_t* reduced, std::size_t reduced_stride, std::uint8_t* out, std::size_t out_stride);
 
  private:
-  // One bilinear tap of the prefiltered image: its top-left texel and the weights (out of 256,
-  // summing to 256) of it, its right neighbour and the two below them. Black is a tap of the black
-  // texel past the image's end.
-  struct Tap {
-    std::int32_t texel = 0;
-    std::uint16_t weights[4] = {0, 0, 0, 0};
-  };
-  struct BorderPixel {
-    std::int32_t pixel = 0;  // y · panel[0] + x
-    std::array<Tap, 4> taps;
-    std::array<float, 4> weights{};
+  // The box pass in fixed point: per output sample of an axis, pairs of input cells with their
+  // weights in 1/32768 (see box_pass).
+  struct FixedAxis {
+    int pairs = 0;                      // most pairs any output sample needs (horizontal: all have this many)
+    std::vector<std::int32_t> first;    // first input cell of each output's pairs
+    std::vector<std::int32_t> begin;    // vertical: index into `weights` per output, plus one past the end
+    std::vector<std::int16_t> weights;  // per pair: the two cells' weights, repeated ×4 (one SSE2 register)
   };
 
-  Tap make_tap(float x, float y) const;
+  static Built build(const Recording& recording);
+  static Tap make_tap(float x, float y, std::array<int, 2> prefiltered);
   static void replay_taps(const Tap* taps, int count, const std::uint8_t* image, std::size_t image_row,
                           std::uint8_t* out);
   void box_pass(const std::uint8_t* reduced, std::size_t reduced_stride);
 
-  std::array<int, 2> panel_, reduced_, prefiltered_;
-  BoxAxis horizontal_, vertical_;
-  std::vector<Tap> taps_;             // per pixel, pass 1
-  std::vector<BorderPixel> borders_;  // pass 2
-  std::vector<float> input_;          // one row of the block means, RGBA as float
-  std::vector<float> across_;         // after the horizontal box pass: prefiltered[0] × reduced[1], RGBA
-  std::vector<std::uint8_t> image_;   // the prefiltered image: prefiltered[0] × prefiltered[1], RGBA8
-  std::vector<float> row_sums_;       // the vertical box pass's accumulators, RGBA per column
+  Built built_;
+  FixedAxis horizontal_, vertical_;
+  std::vector<std::uint8_t> input_;   // one row of the block means, zero-padded for the last pairs
+  std::vector<std::uint8_t> across_;  // after the horizontal pass: across_row_ bytes × reduced[1] rows
+  std::size_t across_row_ = 0;
+  std::vector<std::uint8_t> image_;  // the prefiltered image: prefiltered[0] × prefiltered[1], RGBA8, spare rows
 };
 
 // Both eyes of a stereo frame into a packed RGBA8 frame (row 0 the top row, `stride` bytes a row),

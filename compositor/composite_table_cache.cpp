@@ -19,7 +19,8 @@ namespace nelf {
 
 namespace {
 
-constexpr char kMagic[8] = {'N', 'E', 'L', 'F', 'C', 'T', '1', '\n'};
+// Version 2 holds the built table (taps, not texture coordinates), so a load skips make_tap.
+constexpr char kMagic[8] = {'N', 'E', 'L', 'F', 'C', 'T', '2', '\n'};
 constexpr std::uint64_t kMaxElements = std::uint64_t{1} << 28;  // far beyond any panel
 
 std::uint64_t fnv1a(const std::string& text) {
@@ -52,7 +53,11 @@ class Writer {
 
 class Reader {
  public:
-  explicit Reader(std::ifstream& in) : in_(in) {}
+  explicit Reader(std::ifstream& in) : in_(in) {
+    in_.seekg(0, std::ios::end);
+    end_ = in_.tellg();
+    in_.seekg(0);
+  }
   template <class T>
   bool value(T& v) {
     static_assert(std::is_trivially_copyable_v<T>);
@@ -61,20 +66,26 @@ class Reader {
   template <class T>
   bool vector(std::vector<T>& v) {
     std::uint64_t size = 0;
-    if (!value(size) || size > kMaxElements) return false;
+    if (!value(size) || size > kMaxElements || !fits(size * sizeof(T))) return false;
     v.resize(size);
     return static_cast<bool>(
         in_.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(size * sizeof(T))));
   }
   bool string(std::string& s) {
     std::uint64_t size = 0;
-    if (!value(size) || size > kMaxElements) return false;
+    if (!value(size) || size > kMaxElements || !fits(size)) return false;
     s.resize(size);
     return static_cast<bool>(in_.read(s.data(), static_cast<std::streamsize>(size)));
   }
 
  private:
+  // Whether `bytes` more are in the file: a damaged size allocates nothing.
+  bool fits(std::uint64_t bytes) {
+    const std::streamoff at = in_.tellg();
+    return at >= 0 && end_ >= at && bytes <= static_cast<std::uint64_t>(end_ - at);
+  }
   std::ifstream& in_;
+  std::streamoff end_ = 0;
 };
 
 void write_axis(Writer& w, const BoxAxis& axis) {
@@ -120,7 +131,7 @@ std::filesystem::path CompositeTableCache::path_for(const std::string& key) cons
   return directory_ / fmt::format("{:016x}.table", fnv1a(key));
 }
 
-std::optional<CompositeTable::Recording> CompositeTableCache::load(const std::string& key) const {
+std::optional<CompositeTable> CompositeTableCache::load(const std::string& key) const {
   if (directory_.empty()) return std::nullopt;
   std::ifstream in(path_for(key), std::ios::binary);
   if (!in) return std::nullopt;
@@ -130,15 +141,19 @@ std::optional<CompositeTable::Recording> CompositeTableCache::load(const std::st
   if (!in.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof magic) != 0 || !r.string(stored_key) ||
       stored_key != key)
     return std::nullopt;
-  CompositeTable::Recording recording;
-  if (!r.value(recording.panel) || !r.value(recording.reduced) || !r.value(recording.prefiltered) ||
-      !read_axis(r, recording.horizontal) || !read_axis(r, recording.vertical) || !r.vector(recording.coordinates) ||
-      !r.vector(recording.border_pixels) || !r.vector(recording.border_parts))
+  CompositeTable::Built built;
+  if (!r.value(built.panel) || !r.value(built.reduced) || !r.value(built.prefiltered) ||
+      !read_axis(r, built.horizontal) || !read_axis(r, built.vertical) || !r.vector(built.taps) ||
+      !r.vector(built.borders))
     return std::nullopt;
-  return recording;
+  try {
+    return CompositeTable(std::move(built));  // which checks everything that indexes memory
+  } catch (const std::exception&) {           // inconsistent, or sizes too large to allocate
+    return std::nullopt;
+  }
 }
 
-bool CompositeTableCache::store(const std::string& key, const CompositeTable::Recording& recording) const {
+bool CompositeTableCache::store(const std::string& key, const CompositeTable& table) const {
   if (directory_.empty()) return false;
   std::error_code ec;
   std::filesystem::create_directories(directory_, ec);
@@ -151,14 +166,14 @@ bool CompositeTableCache::store(const std::string& key, const CompositeTable::Re
     Writer w(out);
     out.write(kMagic, sizeof kMagic);
     w.string(key);
-    w.value(recording.panel);
-    w.value(recording.reduced);
-    w.value(recording.prefiltered);
-    write_axis(w, recording.horizontal);
-    write_axis(w, recording.vertical);
-    w.vector(recording.coordinates);
-    w.vector(recording.border_pixels);
-    w.vector(recording.border_parts);
+    const CompositeTable::Built& built = table.built();
+    w.value(built.panel);
+    w.value(built.reduced);
+    w.value(built.prefiltered);
+    write_axis(w, built.horizontal);
+    write_axis(w, built.vertical);
+    w.vector(built.taps);
+    w.vector(built.borders);
     out.flush();
     if (!out) {
       out.close();
@@ -177,22 +192,16 @@ std::optional<CompositeTable> load_or_record_composite_table(const CompositeTabl
                                                              Eye eye, int view_width, int view_height, double aspect,
                                                              std::array<int, 2> block) {
   const std::string key = composite_table_key(profile, options, eye, view_width, view_height, aspect, block);
-  if (auto recording = cache.load(key)) {
-    // An entry for this key describes these views; one that does not (or does not hold together)
-    // is recorded again.
-    const std::array<int, 2> reduced{view_width / block[0], view_height / block[1]};
-    if (recording->panel == profile.display.resolution && recording->reduced == reduced) {
-      try {
-        return CompositeTable(*recording);
-      } catch (const std::invalid_argument&) {
-      }
-    }
-  }
+  // An entry for this key describes these views; one that does not (or does not hold together:
+  // load checks that) is recorded again.
+  const std::array<int, 2> reduced{view_width / block[0], view_height / block[1]};
+  if (auto table = cache.load(key);
+      table && table->panel() == profile.display.resolution && table->reduced_size() == reduced)
+    return table;
   if (!recorder) return std::nullopt;
-  auto recording = recorder->record_composite_table(eye, view_width, view_height, aspect, block);
-  if (!recording) return std::nullopt;
-  cache.store(key, *recording);
-  return CompositeTable(*recording);
+  auto table = recorder->make_composite_table(eye, view_width, view_height, aspect, block);
+  if (table) cache.store(key, *table);
+  return table;
 }
 
 bool has_render_node() {

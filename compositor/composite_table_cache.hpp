@@ -1,5 +1,5 @@
 #pragma once
-// Composite-table recordings kept on disk (like Mesa's shader cache), so that a conversion whose
+// Composite tables kept on disk (like Mesa's shader cache), so that a conversion whose
 // optics and view geometry were seen before starts without a GL context: on a machine without a
 // GPU, loading llvmpipe and recording the tables is ~1 s of the start-up of `nelf convert`,
 // against ~0.3 s for all of ffmpeg's. An entry holds its whole key (profile, eye, view geometry,
@@ -29,10 +29,12 @@ class CompositeTableCache {
   explicit CompositeTableCache(std::filesystem::path directory = default_composite_table_cache())
       : directory_(std::move(directory)) {}
 
-  // The recording stored under `key`, if there is a readable one.
-  std::optional<CompositeTable::Recording> load(const std::string& key) const;
-  // Stores `recording` under `key`; false (and nothing left behind) when that fails.
-  bool store(const std::string& key, const CompositeTable::Recording& recording) const;
+  // The table stored under `key`, if there is a readable one that holds together (an entry is
+  // untrusted input: CompositeTable checks everything that indexes memory).
+  std::optional<CompositeTable> load(const std::string& key) const;
+  // Stores `table` (as built: its taps, so a load needs no make_tap per pixel) under `key`; false
+  // (and nothing left behind) when that fails.
+  bool store(const std::string& key, const CompositeTable& table) const;
 
   const std::filesystem::path& directory() const { return directory_; }
 

@@ -110,7 +110,7 @@ class GlCompositor final : public Compositor {
   // cheaper than render_eye_reduced on a software rasteriser; on a GPU render_eye_reduced wins.
   std::optional<CompositeTable> make_composite_table(Eye eye, int view_width, int view_height, double aspect,
                                                      std::array<int, 2> block);
-  // What make_composite_table builds the table from (e.g. to keep it in a CompositeTableCache).
+  // What make_composite_table builds the table from.
   std::optional<CompositeTable::Recording> record_composite_table(Eye eye, int view_width, int view_height,
                                                                   double aspect, std::array<int, 2> block);
 

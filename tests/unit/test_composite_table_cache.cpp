@@ -2,9 +2,14 @@
 // or missing entries and an unusable directory mean "not cached", never an error or a wrong table.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "compositor/composite_table_cache.hpp"
 #include "support/test_support.hpp"
@@ -25,36 +30,58 @@ CompositeTable::Recording small_recording() {
   return r;
 }
 
-void expect_same(const CompositeTable::Recording& a, const CompositeTable::Recording& b) {
-  EXPECT_EQ(a.panel, b.panel);
-  EXPECT_EQ(a.reduced, b.reduced);
-  EXPECT_EQ(a.prefiltered, b.prefiltered);
-  EXPECT_EQ(a.horizontal.first, b.horizontal.first);
-  EXPECT_EQ(a.horizontal.begin, b.horizontal.begin);
-  EXPECT_EQ(a.horizontal.weights, b.horizontal.weights);
-  EXPECT_EQ(a.vertical.weights, b.vertical.weights);
-  EXPECT_EQ(a.coordinates, b.coordinates);
-  EXPECT_EQ(a.border_pixels, b.border_pixels);
-  ASSERT_EQ(a.border_parts.size(), b.border_parts.size());
-  for (std::size_t i = 0; i < a.border_parts.size(); ++i)
-    for (int k = 0; k < 4; ++k) {
-      EXPECT_EQ(a.border_parts[i][k].x, b.border_parts[i][k].x);
-      EXPECT_EQ(a.border_parts[i][k].weight, b.border_parts[i][k].weight);
-    }
+// A small image to render: RGBA8 block means, `size` of them.
+std::vector<std::uint8_t> test_means(std::array<int, 2> size) {
+  std::vector<std::uint8_t> means(static_cast<std::size_t>(size[0]) * size[1] * 4);
+  for (std::size_t i = 0; i < means.size(); ++i) means[i] = static_cast<std::uint8_t>(i % 4 == 3 ? 255 : 37 * i + 11);
+  return means;
 }
 
-TEST(CompositeTableCache, StoredRecordingComesBackWholeUnderItsKeyOnly) {
+std::vector<std::uint8_t> rendered(CompositeTable& table) {
+  const auto panel = table.panel();
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(panel[0]) * panel[1] * 4, 0);
+  const auto means = test_means(table.reduced_size());
+  table.render(means.data(), static_cast<std::size_t>(table.reduced_size()[0]) * 4, out.data(),
+               static_cast<std::size_t>(panel[0]) * 4);
+  return out;
+}
+
+void expect_same(const CompositeTable& a, const CompositeTable& b) {
+  const CompositeTable::Built &x = a.built(), &y = b.built();
+  EXPECT_EQ(x.panel, y.panel);
+  EXPECT_EQ(x.reduced, y.reduced);
+  EXPECT_EQ(x.prefiltered, y.prefiltered);
+  EXPECT_EQ(x.horizontal.first, y.horizontal.first);
+  EXPECT_EQ(x.horizontal.begin, y.horizontal.begin);
+  EXPECT_EQ(x.horizontal.weights, y.horizontal.weights);
+  EXPECT_EQ(x.vertical.weights, y.vertical.weights);
+  ASSERT_EQ(x.taps.size(), y.taps.size());
+  for (std::size_t i = 0; i < x.taps.size(); ++i) {
+    EXPECT_EQ(x.taps[i].texel, y.taps[i].texel);
+    EXPECT_EQ(x.taps[i].weights, y.taps[i].weights);
+  }
+  ASSERT_EQ(x.borders.size(), y.borders.size());
+  for (std::size_t i = 0; i < x.borders.size(); ++i) {
+    EXPECT_EQ(x.borders[i].x, y.borders[i].x);
+    EXPECT_EQ(x.borders[i].y, y.borders[i].y);
+    EXPECT_EQ(x.borders[i].weights, y.borders[i].weights);
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(x.borders[i].taps[k].texel, y.borders[i].taps[k].texel);
+  }
+}
+
+TEST(CompositeTableCache, StoredTableComesBackWholeUnderItsKeyOnly) {
   test::TempDir dir;
   const CompositeTableCache cache(dir / "tables");
-  const auto recording = small_recording();
+  CompositeTable table(small_recording());
   EXPECT_FALSE(cache.load("key one"));
-  ASSERT_TRUE(cache.store("key one", recording));
-  const auto loaded = cache.load("key one");
+  ASSERT_TRUE(cache.store("key one", table));
+  auto loaded = cache.load("key one");
   ASSERT_TRUE(loaded);
-  expect_same(*loaded, recording);
+  expect_same(*loaded, table);
   EXPECT_FALSE(cache.load("key two"));
-  // The table built from it works like one built from the recording itself.
-  EXPECT_EQ(CompositeTable(*loaded).panel(), (std::array<int, 2>{3, 2}));
+  // The loaded table renders what the one built from the recording does.
+  EXPECT_EQ(loaded->panel(), (std::array<int, 2>{3, 2}));
+  EXPECT_EQ(rendered(*loaded), rendered(table));
   // Nothing but the entry (no temporary file) is left in the directory.
   EXPECT_EQ(test::files_in(dir / "tables").size(), 1u);
 }
@@ -62,7 +89,7 @@ TEST(CompositeTableCache, StoredRecordingComesBackWholeUnderItsKeyOnly) {
 TEST(CompositeTableCache, DamagedEntriesAreNotUsed) {
   test::TempDir dir;
   const CompositeTableCache cache(dir.path());
-  ASSERT_TRUE(cache.store("key", small_recording()));
+  ASSERT_TRUE(cache.store("key", CompositeTable(small_recording())));
   const auto entry = dir / test::files_in(dir.path()).at(0);
   const auto size = std::filesystem::file_size(entry);
   std::filesystem::resize_file(entry, size - 5);  // truncated
@@ -72,7 +99,7 @@ TEST(CompositeTableCache, DamagedEntriesAreNotUsed) {
     out << "not a table at all";
   }
   EXPECT_FALSE(cache.load("key"));
-  ASSERT_TRUE(cache.store("key", small_recording()));  // a new store replaces the damaged one
+  ASSERT_TRUE(cache.store("key", CompositeTable(small_recording())));  // a new store replaces the damaged one
   EXPECT_TRUE(cache.load("key"));
 }
 
@@ -80,10 +107,10 @@ TEST(CompositeTableCache, UnusableDirectoryMeansNoCache) {
   test::TempDir dir;
   test::write_file(dir / "file", "x");
   const CompositeTableCache under_a_file(dir / "file" / "tables");
-  EXPECT_FALSE(under_a_file.store("key", small_recording()));
+  EXPECT_FALSE(under_a_file.store("key", CompositeTable(small_recording())));
   EXPECT_FALSE(under_a_file.load("key"));
   const CompositeTableCache none{std::filesystem::path{}};
-  EXPECT_FALSE(none.store("key", small_recording()));
+  EXPECT_FALSE(none.store("key", CompositeTable(small_recording())));
   EXPECT_FALSE(none.load("key"));
 }
 
@@ -135,6 +162,78 @@ TEST(CompositeTableCache, InconsistentRecordingsAreRefusedByTheTable) {
   bad = small_recording();
   bad.vertical.begin.back() = 99;
   EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+}
+
+// A built table (what a cache entry holds) must not index outside its buffers either.
+TEST(CompositeTableCache, InconsistentBuiltTablesAreRefused) {
+  const CompositeTable table(small_recording());
+  const CompositeTable::Built good = table.built();
+  const std::int32_t texels = good.prefiltered[0] * good.prefiltered[1];
+  EXPECT_NO_THROW(CompositeTable{good});
+  auto bad = good;
+  bad.taps[2].texel = texels + good.prefiltered[0] + 1;  // its 2×2 texels run past the spare rows
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+  bad = good;
+  bad.taps[0].texel = -1;
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+  bad = good;
+  bad.taps[1].weights = {200, 100, 0, 0};  // not out of 256
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+  bad = good;
+  bad.taps.pop_back();
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+  bad = good;
+  bad.borders[0].x = good.panel[0];
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+  bad = good;
+  bad.borders[1].taps[3].texel = texels * 4;  // even a part without weight
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+  bad = good;
+  std::swap(bad.borders[0], bad.borders[1]);  // render takes them row by row, in order
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+  bad = good;
+  bad.prefiltered = {1 << 20, 3};
+  EXPECT_THROW(CompositeTable{bad}, std::invalid_argument);
+}
+
+// The taps stored in an entry are checked when it is loaded: one pointing outside the image makes
+// the entry unusable, not a read outside the table's buffers.
+TEST(CompositeTableCache, EntriesWhoseTapsPointOutsideTheImageAreNotUsed) {
+  test::TempDir dir;
+  const CompositeTableCache cache(dir.path());
+  const CompositeTable table(small_recording());
+  ASSERT_TRUE(cache.store("key", table));
+  ASSERT_TRUE(cache.load("key"));
+  const auto entry = dir / test::files_in(dir.path()).at(0);
+  std::string bytes;
+  {
+    std::ifstream in(entry, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  // The taps follow their count (a 64-bit 6: the panel is 3×2); find them by the first tap's bytes.
+  const auto& taps = table.built().taps;
+  std::string pattern(8 + sizeof(CompositeTable::Tap), '\0');
+  const std::uint64_t count = taps.size();
+  std::memcpy(pattern.data(), &count, 8);
+  std::memcpy(pattern.data() + 8, &taps[0], sizeof taps[0]);
+  const auto at = bytes.find(pattern);
+  ASSERT_NE(at, std::string::npos);
+  ASSERT_EQ(bytes.find(pattern, at + 1), std::string::npos);
+  const std::int32_t outside = 1 << 30;
+  std::memcpy(bytes.data() + at + 8, &outside, sizeof outside);
+  {
+    std::ofstream out(entry, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  EXPECT_FALSE(cache.load("key"));
+  // A count larger than the file is refused before anything is allocated for it.
+  const std::uint64_t huge = std::uint64_t{1} << 27;
+  std::memcpy(bytes.data() + at, &huge, 8);
+  {
+    std::ofstream out(entry, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  EXPECT_FALSE(cache.load("key"));
 }
 
 }  // namespace
