@@ -668,7 +668,8 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     };
   };
   source.reduce_views(blocks_for(options.profile));
-  FrameQueue queue(6);
+  constexpr std::size_t queue_capacity = 6;
+  FrameQueue queue(queue_capacity);
   std::jthread decoder([&] { decode_loop(source, queue); });
   struct StopDecoder {
     FrameQueue& queue;
@@ -865,8 +866,17 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
                 present_s, queued.size(), ahead);
     ++refresh;
 
-    // The next frames, composited on the worker while this thread waits for the next refresh.
-    renderer.composite_ahead(swap_eyes, queue.front(PackedRenderer::ahead_depth));
+    // The next frames, composited on the worker while this thread waits for the next refresh; not
+    // those whose time will have passed by then (the next refresh drops them): after a slow spell
+    // the worker would otherwise spend itself on frames never shown.
+    {
+      const std::vector<FrameQueue::Frame> next = queue.front(queue_capacity);
+      std::vector<double> next_pts;
+      for (const auto& f : next) next_pts.push_back(f->pts_s);
+      const double next_visible = clock->now() + refresh_period + (display.vsync() ? refresh_period : render_s);
+      const std::size_t stale = scheduler.stale(next_visible, next_pts);
+      renderer.composite_ahead(swap_eyes, std::span(next).subspan(stale));
+    }
 
     if (!display.vsync()) {
       next_tick += std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(refresh_period));
