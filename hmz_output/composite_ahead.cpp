@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstring>
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 namespace nelf {
 
 void draw_over(std::vector<std::uint8_t>& pixels, const Image& cover, int bits) {
@@ -85,7 +88,8 @@ std::optional<CompositeAhead::Packed> CompositeAhead::take(const StereoVideoFram
   for (auto e = wanted_.begin(); e != found + 1; ++e)
     if (e->packed) pool_.push_back(std::move(e->packed));
   wanted_.erase(wanted_.begin(), found + 1);
-  wake_.notify_all();
+  // The worker is not woken here, nor when the packed frame comes back: the display's thread is
+  // about to present, and the next want() (after present()) wakes it.
   return out;
 }
 
@@ -119,10 +123,15 @@ std::unique_ptr<CompositeAhead::Bytes> CompositeAhead::acquire() {
 void CompositeAhead::recycle(std::unique_ptr<Bytes> bytes) {
   std::lock_guard lock(mutex_);
   pool_.push_back(std::move(bytes));
-  wake_.notify_all();
 }
 
 void CompositeAhead::run(std::stop_token stop) {
+  // Below the display's thread and the X server: the worker has a frame period of slack, present()
+  // has none. At the same priority, compositing the next frame while the display's thread presented
+  // made present() (mostly the X server's swap) take ~28 ms instead of ~10 ms on two cores, more than
+  // the compositing it saved. Linux: the nice value is per thread, and render_packed_eyes' second
+  // thread inherits it. Failing to lower it is not an error.
+  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), worker_nice_);
   std::unique_lock lock(mutex_);
   while (wake_.wait(lock, stop, [&] { return has_work(); })) {
     const auto next =

@@ -121,8 +121,9 @@ class CompositeAhead {
   bool composite(const CompositeSetup& setup, const StereoVideoFrame& frame, Bytes& out);
 
   const std::size_t depth_;
+  static constexpr int worker_nice_ = 10;
   mutable std::mutex mutex_;
-  std::condition_variable_any wake_;  // the worker: new work, a free buffer, stop
+  std::condition_variable_any wake_;  // the worker: want() (after present()), stop
   std::condition_variable done_;      // take(): the frame in hand is finished
   std::shared_ptr<const CompositeSetup> setup_;
   std::vector<Entry> wanted_;  // in showing order, ≤ depth_
