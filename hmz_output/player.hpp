@@ -3,8 +3,9 @@
 // stereo frames; the display's thread (the caller's) paces them against the master clock with
 // FrameScheduler, uploads each new frame's two views once, composites both eyes with GlCompositor
 // straight into the display's packed framebuffer (on software GL, 8-bit block means: from composite
-// tables on the CPU, then one upload of the packed frame) and presents. An audio thread feeds SDL2 audio,
-// whose clock is master; without sound a system clock is. Keys change playback and the optics live.
+// tables on the CPU, the next frames ahead on a worker thread (CompositeAhead), then one upload of
+// the packed frame) and presents. An audio thread feeds SDL2 audio, whose clock is master; without
+// sound a system clock is. Keys change playback and the optics live.
 #include <atomic>
 #include <cstdint>
 #include <functional>
