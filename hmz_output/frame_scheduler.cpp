@@ -30,6 +30,12 @@ void FrameScheduler::reset() {
   estimated_frame_period_ = 0.0;
 }
 
+std::size_t FrameScheduler::stale(double visible_at, std::span<const double> queued) const {
+  std::size_t due = 0;
+  while (due < queued.size() && is_due(queued[due], visible_at)) ++due;
+  return due > 0 ? due - 1 : 0;
+}
+
 FrameDecision FrameScheduler::decide(double visible_at, std::span<const double> queued, bool end_of_stream) {
   FrameDecision decision;
   std::size_t due = 0;  // frames at the front of the queue that are due now

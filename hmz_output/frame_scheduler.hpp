@@ -42,6 +42,10 @@ class FrameScheduler {
   // visible_at: master clock time at which this refresh becomes visible. queued: pts of the frames
   // decoded and not yet shown, oldest first (ascending). end_of_stream: no more frames will come.
   FrameDecision decide(double visible_at, std::span<const double> queued, bool end_of_stream);
+  // How many frames at the front of `queued` a refresh visible at `visible_at` would drop unshown
+  // (the due ones but the newest); changes nothing. The player composites ahead only the frames
+  // after them.
+  std::size_t stale(double visible_at, std::span<const double> queued) const;
 
   // After a seek or a flush: nothing is on screen any more as far as pacing is concerned (the
   // counters are kept).

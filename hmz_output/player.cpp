@@ -22,6 +22,7 @@
 #include "compositor/image_library.hpp"
 #include "compositor/text_overlay.hpp"
 #include "hmz_output/audio_output.hpp"
+#include "hmz_output/composite_ahead.hpp"
 #include "hmz_output/packing.hpp"
 #include "inputs/audio_source.hpp"
 #include "inputs/test_patterns.hpp"
@@ -36,8 +37,12 @@ double seconds_since(Steady::time_point t) { return std::chrono::duration<double
 
 // Decoded frames waiting for their refresh. The decode thread fills it up to `capacity`; a seek
 // empties it and bumps the generation so that a frame decoded before the seek is never queued.
+// Frames are shared read-only from here on: the compositing-ahead worker reads the next ones while
+// they wait (CompositeAhead).
 class FrameQueue {
  public:
+  using Frame = CompositeAhead::Frame;
+
   explicit FrameQueue(std::size_t capacity) : capacity_(capacity) {}
 
   // Decode thread: waits for room (or a seek, a new reduction, or stop). Returns the seek target
@@ -57,7 +62,7 @@ class FrameQueue {
   void push(StereoVideoFrame frame, std::uint64_t generation) {
     std::lock_guard lock(mutex_);
     if (generation != generation_) return;  // decoded before a seek
-    items_.push_back(std::move(frame));
+    items_.push_back(std::make_shared<const StereoVideoFrame>(std::move(frame)));
     changed_.notify_all();
   }
   void set_end(std::uint64_t generation) {
@@ -99,21 +104,27 @@ class FrameQueue {
     if (error_) std::rethrow_exception(error_);
     std::vector<double> pts;
     pts.reserve(items_.size());
-    for (const auto& f : items_) pts.push_back(f.pts_s);
+    for (const auto& f : items_) pts.push_back(f->pts_s);
     end = end_ && !seek_to_;
     return pts;
   }
-  // Removes `drop` frames, then returns the next one if `take`.
-  std::optional<StereoVideoFrame> pop(std::size_t drop, bool take) {
+  // Removes `drop` frames, then returns the next one if `take` (null when there is none).
+  Frame pop(std::size_t drop, bool take) {
     std::lock_guard lock(mutex_);
     for (std::size_t i = 0; i < drop && !items_.empty(); ++i) items_.pop_front();
-    std::optional<StereoVideoFrame> out;
+    Frame out;
     if (take && !items_.empty()) {
       out = std::move(items_.front());
       items_.pop_front();
     }
     changed_.notify_all();
     return out;
+  }
+  // The first `count` queued frames (fewer when fewer are there), oldest first; they stay queued.
+  std::vector<Frame> front(std::size_t count) {
+    std::lock_guard lock(mutex_);
+    return std::vector<Frame>(items_.begin(),
+                              items_.begin() + static_cast<std::ptrdiff_t>(std::min(count, items_.size())));
   }
   // Waits up to `timeout` for a frame (or the end); true when one is there.
   bool wait_for_frame(std::chrono::milliseconds timeout) {
@@ -126,7 +137,7 @@ class FrameQueue {
  private:
   std::mutex mutex_;
   std::condition_variable changed_;
-  std::deque<StereoVideoFrame> items_;
+  std::deque<Frame> items_;
   std::size_t capacity_;
   std::optional<double> seek_to_;
   std::optional<ViewBlockChooser> reduce_;
@@ -238,31 +249,10 @@ class AudioFeeder {
   std::jthread thread_;  // last: stops before the members it uses go
 };
 
-// The calibration overlay: `nelf calibrate`'s grid pattern (lines 16 cells across, a yellow centre
-// cross, the eye's letter) drawn over the view, so that the eyes' alignment and the lens grid can
-// be judged on the movie itself. `cover` is the grid at the texture's size (cover_grid): where its
-// alpha is 1 the grid replaces the movie, where 0 the movie shows through.
-void draw_over(std::vector<std::uint8_t>& pixels, const Image& cover, int bits) {
-  const std::size_t n = static_cast<std::size_t>(cover.width()) * cover.height();
-  const float* p = cover.data();
-  for (std::size_t i = 0; i < n; ++i) {
-    const float a = p[i * 4 + 3];
-    if (a <= 0.f) continue;
-    for (std::size_t c = 0; c < 3; ++c) {
-      const float grid = std::clamp(p[i * 4 + c], 0.f, 1.f);
-      if (bits > 8) {
-        std::uint16_t u = 0;
-        std::memcpy(&u, &pixels[i * 8 + c * 2], 2);
-        u = static_cast<std::uint16_t>(std::lround((u / 65535.f * (1.f - a) + grid * a) * 65535.f));
-        std::memcpy(&pixels[i * 8 + c * 2], &u, 2);
-      } else {
-        pixels[i * 4 + c] =
-            static_cast<std::uint8_t>(std::lround((pixels[i * 4 + c] / 255.f * (1.f - a) + grid * a) * 255.f));
-      }
-    }
-  }
-}
-
+// The calibration overlay is `nelf calibrate`'s grid pattern (lines 16 cells across, a yellow
+// centre cross, the eye's letter) drawn over the view (draw_over, hmz_output/composite_ahead), so
+// that the eyes' alignment and the lens grid can be judged on the movie itself.
+//
 // The full-size grid `pattern` as drawn over block means of `block` pixels: per block, alpha = the
 // share of its pixels the grid covers (not black), colour = their mean. Blending that over the
 // block mean of the movie gives exactly the block mean of the grid drawn over the full view, so
@@ -292,6 +282,10 @@ Image cover_grid(const Image& pattern, std::array<int, 2> block) {
 // on software GL also the CPU path, composite tables replayed from the views' bytes.
 class PackedRenderer {
  public:
+  // Frames composited ahead: two cover a slow composite (40 ms) at 30 fps, with three packed frames
+  // (7.5 MB each at 720p frame packing) in memory.
+  static constexpr std::size_t ahead_depth = 2;
+
   PackedRenderer(Display& display, const PlayerOptions& options)
       : display_(display), options_(options), prefer_tables_(prefer_composite_table(*display.context())) {
     profile_ = options.profile;
@@ -313,8 +307,12 @@ class PackedRenderer {
   const Profile& profile() const { return profile_; }
 
   // The frame's views into the view textures: whole views, or (frame.block > 1×1) the block means
-  // the compositor's prefilter starts from, 1/block² of the texels to upload and composite.
-  void upload(const StereoVideoFrame& frame, bool calibration) {
+  // the compositor's prefilter starts from, 1/block² of the texels to upload and composite. The
+  // frame is kept: render() may find it composited ahead.
+  void upload(std::shared_ptr<const StereoVideoFrame> shared, bool calibration) {
+    frame_ = std::move(shared);
+    calibration_ = calibration;
+    const StereoVideoFrame& frame = *frame_;
     if (frame.width != view_w_ || frame.height != view_h_ || frame.bits != bits_ || frame.block != block_ ||
         frame.aspect != aspect_) {
       view_w_ = frame.width;
@@ -353,7 +351,9 @@ class PackedRenderer {
     const PatternGeometry geometry = pattern_geometry(profile_, view_w_, view_h_);
     if (!grid_ || !(grid_geometry_ == geometry) || grid_block_ != block_) {
       const StereoPair pair = make_test_pattern(TestPattern::grid, geometry);
-      grid_ = {cover_grid(pair.left.image, block_), cover_grid(pair.right.image, block_)};
+      // A new object, never changed: a CompositeSetup holding the old one stays as it was made.
+      grid_ = std::make_shared<const std::array<Image, 2>>(
+          std::array<Image, 2>{cover_grid(pair.left.image, block_), cover_grid(pair.right.image, block_)});
       grid_geometry_ = geometry;
       grid_block_ = block_;
     }
@@ -364,16 +364,25 @@ class PackedRenderer {
   // is seen in focus through the lenses.
   void set_message(const std::string& text) { overlay_.set_text(text); }
 
-  // Both eyes into the display's packed framebuffer; the gap (and any border) black.
-  void render(bool swap_eyes) {
+  // Both eyes into the display's packed framebuffer; the gap (and any border) black. True when the
+  // frame came composited ahead by the worker.
+  bool render(bool swap_eyes) {
     if (use_tables()) {
+      // Only a packed frame made for this frame with exactly the current setup; else as before.
+      const auto setup = frame_ ? ahead_setup(swap_eyes) : nullptr;
+      if (setup) {
+        if (const auto packed = ahead_.take(*frame_, *setup)) {
+          upload_packed(packed->data());
+          return true;
+        }
+      }
       render_from_tables(swap_eyes);
-      return;
+      return false;
     }
     const GLuint fbo = display_.packed_framebuffer();
     const float black[4] = {0.f, 0.f, 0.f, 1.f};
     glClearNamedFramebufferfv(fbo, GL_COLOR, 0, black);
-    if (view_w_ == 0) return;
+    if (view_w_ == 0) return false;
     for (Eye eye : {Eye::left, Eye::right}) {
       const auto& origin = origins_[static_cast<int>(eye)];
       if (!origin) continue;
@@ -389,6 +398,13 @@ class PackedRenderer {
       else  // whole views, or block means made for optics changed since (a key): a smaller view
         compositor_->render_eye(eye, shown, target);
     }
+    return false;
+  }
+
+  // Every refresh: `frames` (the next to be shown, in order) to be composited ahead on the worker
+  // with the setup render() would use now, or none when it would not use the tables.
+  void composite_ahead(bool swap_eyes, std::span<const CompositeAhead::Frame> frames) {
+    ahead_.want(ahead_setup(swap_eyes), frames);
   }
 
  private:
@@ -400,10 +416,14 @@ class PackedRenderer {
   // GL onto the view textures), nor with block means made for optics a key has changed since
   // (the GL path's smaller view covers the frames until the new block arrives). Records the
   // tables on first use for the current views and optics.
-  bool use_tables() {
+  bool table_path_open() const {
     if (view_w_ == 0 || !may_use_tables() || !overlay_.text().empty()) return false;
     for (Eye eye : {Eye::left, Eye::right})
       if (origins_[static_cast<int>(eye)] && block_ != wanted_block(eye)) return false;
+    return true;
+  }
+  bool use_tables() {
+    if (!table_path_open()) return false;
     if (!tables_tried_) {
       tables_tried_ = true;
       for (Eye eye : {Eye::left, Eye::right}) {
@@ -425,6 +445,32 @@ class PackedRenderer {
   void forget_tables() {
     tables_ = {};
     tables_tried_ = false;
+    worker_tables_.reset();
+    setup_.reset();
+  }
+
+  // What the worker composites the next frames with: exactly what render_from_tables() would use
+  // for them now (tables, eye positions, swap, calibration grid, views). Null while render() would
+  // not take the table path, and until render() has made the tables (that needs GL, this thread).
+  // A new setup for every change, so that frames made with the old one are never shown.
+  std::shared_ptr<const CompositeSetup> ahead_setup(bool swap_eyes) {
+    if (!table_path_open() || !tables_tried_ || !(tables_[0] || tables_[1])) return nullptr;
+    std::shared_ptr<const std::array<Image, 2>> grid;
+    if (calibration_) {
+      try {
+        calibration_grid(0);  // as upload() would make it for the next frame (the optics may have changed)
+      } catch (const TestPatternError&) {
+        return nullptr;
+      }
+      grid = grid_;
+    }
+    if (!setup_ || setup_->swap_eyes != swap_eyes || setup_->grid != grid) {
+      // The worker's own copy (once per tables): a table's render() uses its scratch buffers.
+      if (!worker_tables_) worker_tables_ = std::make_shared<std::array<std::optional<CompositeTable>, 2>>(tables_);
+      setup_ = std::make_shared<const CompositeSetup>(CompositeSetup{
+          worker_tables_, origins_, display_.packed_size(), swap_eyes, grid, view_w_, view_h_, block_, aspect_});
+    }
+    return setup_;
   }
   // Both eyes into a CPU copy of the packed frame, then that into the display's texture: one
   // upload of the whole frame, since the eyes' panels are nearly all of it.
@@ -440,9 +486,12 @@ class PackedRenderer {
     const int swap = swap_eyes ? 1 : 0;
     render_packed_eyes(tables_, {view_bytes_[swap].data(), view_bytes_[1 - swap].data()},
                        static_cast<std::size_t>(texture_w()) * 4, origins_, packed_bytes_.data(), stride);
+    upload_packed(packed_bytes_.data());
+  }
+  void upload_packed(const std::uint8_t* pixels) {
+    const auto packed = display_.packed_size();
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTextureSubImage2D(display_.packed_texture(), 0, 0, 0, packed[0], packed[1], GL_RGBA, GL_UNSIGNED_BYTE,
-                        packed_bytes_.data());
+    glTextureSubImage2D(display_.packed_texture(), 0, 0, 0, packed[0], packed[1], GL_RGBA, GL_UNSIGNED_BYTE, pixels);
     gl::check_error("uploading the packed frame");
   }
 
@@ -486,7 +535,7 @@ class PackedRenderer {
   Profile profile_;
   std::unique_ptr<GlCompositor> compositor_;
   TextOverlay overlay_;
-  std::optional<std::array<Image, 2>> grid_;
+  std::shared_ptr<const std::array<Image, 2>> grid_;
   PatternGeometry grid_geometry_;
   std::array<int, 2> grid_block_{1, 1};
   std::array<std::optional<std::pair<int, int>>, 2> origins_;
@@ -497,12 +546,19 @@ class PackedRenderer {
   std::array<std::vector<std::uint8_t>, 2> view_bytes_;
   std::array<std::optional<CompositeTable>, 2> tables_;
   bool tables_tried_ = false;
+  // Compositing ahead: the frame last uploaded and whether with the grid, the worker's copy of the
+  // tables and the setup last handed to it, and the worker (last: it stops first).
+  std::shared_ptr<const StereoVideoFrame> frame_;
+  bool calibration_ = false;
+  std::shared_ptr<std::array<std::optional<CompositeTable>, 2>> worker_tables_;
+  std::shared_ptr<const CompositeSetup> setup_;
   const CompositeTableCache table_cache_;
   std::vector<std::uint8_t> packed_bytes_;
   int view_w_ = 0, view_h_ = 0, bits_ = 8;
   std::array<int, 2> block_{1, 1};  // of the views in the textures
   std::array<std::array<int, 2>, 2> wanted_blocks_{};
   double aspect_ = 0.0;
+  CompositeAhead ahead_{ahead_depth};
 };
 
 class FrameLog {
@@ -511,8 +567,10 @@ class FrameLog {
     if (path.empty()) return;
     file_ = std::fopen(path.c_str(), "w");
     if (!file_) throw UserError(fmt::format("{}: cannot write the frame log", path), 1);
-    std::fputs("refresh,event,pts_s,clock_s,audio_clock_s,shown,repeated,dropped,upload_ms,render_ms,present_ms\n",
-               file_);
+    std::fputs(
+        "refresh,event,pts_s,clock_s,audio_clock_s,shown,repeated,dropped,upload_ms,render_ms,present_ms,queued,"
+        "ahead\n",
+        file_);
   }
   ~FrameLog() {
     if (file_) std::fclose(file_);
@@ -520,16 +578,17 @@ class FrameLog {
   FrameLog(const FrameLog&) = delete;
   FrameLog& operator=(const FrameLog&) = delete;
   bool enabled() const { return file_ != nullptr; }
-  // Times in seconds; what was not done this refresh is 0.
+  // Times in seconds; what was not done this refresh is 0. `queued`: decoded frames waiting at the
+  // decision; `ahead`: the frame rendered was composited ahead by the worker.
   void write(std::int64_t refresh, const char* event, std::optional<double> pts, double clock,
              std::optional<double> audio_clock, const FrameCounters& c, double upload_s, double render_s,
-             double present_s) {
+             double present_s, std::size_t queued, bool ahead) {
     if (!file_) return;
-    std::fprintf(file_, "%lld,%s,%s,%.6f,%s,%lld,%lld,%lld,%.2f,%.2f,%.2f\n", static_cast<long long>(refresh), event,
-                 pts ? fmt::format("{:.6f}", *pts).c_str() : "", clock,
+    std::fprintf(file_, "%lld,%s,%s,%.6f,%s,%lld,%lld,%lld,%.2f,%.2f,%.2f,%zu,%d\n", static_cast<long long>(refresh),
+                 event, pts ? fmt::format("{:.6f}", *pts).c_str() : "", clock,
                  audio_clock ? fmt::format("{:.6f}", *audio_clock).c_str() : "", static_cast<long long>(c.shown),
                  static_cast<long long>(c.repeated), static_cast<long long>(c.dropped), upload_s * 1e3, render_s * 1e3,
-                 present_s * 1e3);
+                 present_s * 1e3, queued, ahead ? 1 : 0);
   }
 
  private:
@@ -618,7 +677,8 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     };
   };
   source.reduce_views(blocks_for(options.profile));
-  FrameQueue queue(6);
+  constexpr std::size_t queue_capacity = 6;
+  FrameQueue queue(queue_capacity);
   std::jthread decoder([&] { decode_loop(source, queue); });
   struct StopDecoder {
     FrameQueue& queue;
@@ -630,7 +690,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   bool paused = false, started = false, calibration = false, swap_eyes = false, dirty = false;
   bool awaiting_seek = false;
   bool show_while_paused = false;  // a seek while paused shows the first frame at the new place
-  std::optional<StereoVideoFrame> current;
+  std::shared_ptr<const StereoVideoFrame> current;
   std::string message;
   Steady::time_point message_until{};
   // Time from the decision to the end of present(): the median of the last few renders (the first,
@@ -642,10 +702,11 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   auto next_tick = Steady::now();
 
   auto say = [&](std::string text) {
+    dirty = true;
+    if (!options.on_screen_messages) return;
     message = std::move(text);
     renderer.set_message(message);
     message_until = Steady::now() + std::chrono::seconds(2);
-    dirty = true;
   };
   auto seek_by = [&](double delta) {
     const double from = current ? current->pts_s : clock->now();
@@ -711,10 +772,10 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
       } else if (key.is(U'c') || key.is(U'C')) {
         calibration = !calibration;
         try {
-          if (current) renderer.upload(*current, calibration);
+          if (current) renderer.upload(current, calibration);
         } catch (const TestPatternError& e) {
           calibration = false;
-          if (current) renderer.upload(*current, calibration);
+          if (current) renderer.upload(current, calibration);
           say(fmt::format("no calibration grid: {}", e.what()));
           continue;
         }
@@ -760,7 +821,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
           show_while_paused = false;
           current = std::move(frame);
           const auto t = Steady::now();
-          renderer.upload(*current, calibration);
+          renderer.upload(current, calibration);
           if (log.enabled()) glFinish();  // so that the log says where the time goes
           upload_s = seconds_since(t);
           dirty = true;
@@ -777,9 +838,11 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     }
     if (finished) break;
 
+    bool ahead = false;
     if (dirty) {
       auto t = Steady::now();
-      renderer.render(swap_eyes);
+      ahead = renderer.render(swap_eyes);
+      if (ahead) ++result.composited_ahead;
       if (log.enabled()) glFinish();
       render_only_s = seconds_since(t);
       if (options.after_render) options.after_render(display, current ? current->pts_s : 0.0);
@@ -809,8 +872,20 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     if (event)
       log.write(refresh, event, current ? std::optional(current->pts_s) : std::nullopt, clock->now(),
                 audio ? std::optional(audio->now()) : std::nullopt, scheduler.counters(), upload_s, render_only_s,
-                present_s);
+                present_s, queued.size(), ahead);
     ++refresh;
+
+    // The next frames, composited on the worker while this thread waits for the next refresh; not
+    // those whose time will have passed by then (the next refresh drops them): after a slow spell
+    // the worker would otherwise spend itself on frames never shown.
+    {
+      const std::vector<FrameQueue::Frame> next = queue.front(queue_capacity);
+      std::vector<double> next_pts;
+      for (const auto& f : next) next_pts.push_back(f->pts_s);
+      const double next_visible = clock->now() + refresh_period + (display.vsync() ? refresh_period : render_s);
+      const std::size_t stale = scheduler.stale(next_visible, next_pts);
+      renderer.composite_ahead(swap_eyes, std::span(next).subspan(stale));
+    }
 
     if (!display.vsync()) {
       next_tick += std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(refresh_period));

@@ -3,8 +3,9 @@
 // stereo frames; the display's thread (the caller's) paces them against the master clock with
 // FrameScheduler, uploads each new frame's two views once, composites both eyes with GlCompositor
 // straight into the display's packed framebuffer (on software GL, 8-bit block means: from composite
-// tables on the CPU, then one upload of the packed frame) and presents. An audio thread feeds SDL2 audio,
-// whose clock is master; without sound a system clock is. Keys change playback and the optics live.
+// tables on the CPU, the next frames ahead on a worker thread (CompositeAhead), then one upload of
+// the packed frame) and presents. An audio thread feeds SDL2 audio, whose clock is master; without
+// sound a system clock is. Keys change playback and the optics live.
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -28,6 +29,10 @@ struct PlayerOptions {
   int audio_rate = 48000;
   std::string log_frames;  // CSV of every refresh (diagnostics); "" = none
   bool quiet = false;      // no "playing …" / audio status lines on stderr
+  // Each key's change said on screen for 2 s. Off (tests): while a message shows, frames are
+  // composited with GL (the text is drawn there), so without them the CPU path and its frames
+  // composited ahead are seen right after a key.
+  bool on_screen_messages = true;
   // Called after each new frame is rendered into the packed framebuffer, before present(); the
   // display's context is current (tests read the frame back here).
   std::function<void(const Display&, double pts_s)> after_render;
@@ -40,6 +45,7 @@ struct PlayResult {
   FrameCounters counters;
   std::int64_t video_decode_errors = 0;
   std::int64_t audio_decode_errors = 0;
+  std::int64_t composited_ahead = 0;  // frames shown as composited ahead on a worker (CPU path)
   bool had_sound = false;
   std::string sound;  // "pulseaudio, 48000 Hz …" or why there was none
 };

@@ -11,6 +11,7 @@
 #   SECONDS  clip length (default 10)
 #   FSAA     --fsaa for play (default 1)
 #   PROFILE  the device profile (default hmz-t1)
+# With PACING_LOGS=DIR the frame logs are kept there as log24.csv, log30.csv, log60.csv.
 set -euo pipefail
 nelf=$(realpath "${1:-build/nelf}")
 seconds=${2:-10}
@@ -61,6 +62,7 @@ for fps in 24 30 60; do
       return n ? a[int((n + 1) / 2)] : 0 }
     END { printf "%.1f %.1f %.1f %d", median(up, n), median(co, n), median(pr, n), late }' "$log")
   read -r up co pr late <<<"$stats"
+  if [ -n "${PACING_LOGS:-}" ]; then mkdir -p "$PACING_LOGS" && cp "$log" "$PACING_LOGS/"; fi
   printf '| %d fps, %d s | %d | %s | %s | %s | %s | %s | %s | %s |\n' "$fps" "$seconds" $((fps * seconds)) \
     "$shown" "$repeated" "$dropped" "$up" "$co" "$pr" "$late"
 done

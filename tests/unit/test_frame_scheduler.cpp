@@ -12,6 +12,19 @@
 namespace nelf {
 namespace {
 
+TEST(FrameSchedulerStale, CountsTheDueFramesButTheNewestAndChangesNothing) {
+  FrameScheduler s(1 / 60.0, 1 / 30.0);
+  const std::vector<double> queued{0.0, 1 / 30.0, 2 / 30.0, 3 / 30.0};
+  EXPECT_EQ(s.stale(-1.0, queued), 0u);      // nothing due
+  EXPECT_EQ(s.stale(0.0, queued), 0u);       // the first due: shown, not dropped
+  EXPECT_EQ(s.stale(2 / 30.0, queued), 2u);  // three due: the newest shown
+  EXPECT_EQ(s.stale(1.0, queued), 3u);       // all due
+  EXPECT_EQ(s.stale(1.0, std::vector<double>{}), 0u);
+  const FrameDecision d = s.decide(2 / 30.0, queued, false);
+  EXPECT_EQ(d.drop, 2u);               // what decide() drops
+  EXPECT_EQ(s.counters().dropped, 2);  // stale() counted nothing
+}
+
 // Plays `frames` frames at `fps` on a display refreshing at `hz`: at each refresh the frames decoded
 // by then (decoded_at(k) ≤ the refresh's clock) are in the queue. Records which frame each refresh
 // shows and checks every decision against the queue it was given.

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
@@ -287,7 +288,8 @@ TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessag
   // with 's' and 'c' pressed at 1 s: their message (2 s) is drawn with GL onto the view textures,
   // so the table run hands those frames to GL, and then the table again, eyes swapped and the
   // calibration grid drawn into the views' bytes. Every frame both runs rendered (by pts: a loaded
-  // machine may drop different ones) looks the same, text and grid included.
+  // machine may drop different ones) looks the same, text and grid included. Outside the message
+  // the table run's frames are mostly composited ahead, on a worker (hmz_output/composite_ahead).
   const auto clip = make_clip(dir_, 4);
   PlayerOptions options = silent_options();
   const auto wanted = stereo_prefilter_block(options.profile, options.compositor, 320, 180, 0.0);
@@ -319,8 +321,16 @@ TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessag
     };
     auto source = open_stereo_frame_source(
         StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
-    EXPECT_EQ(play(*display, *source, options).end, PlayEnd::end_of_file);
+    const PlayResult result = play(*display, *source, options);
+    EXPECT_EQ(result.end, PlayEnd::end_of_file);
     ASSERT_TRUE(pressed);
+    // The table run shows most frames as composited ahead on the worker (the frames compared
+    // below are mostly those), the GL run none.
+    if (path == 0) {
+      EXPECT_GE(result.composited_ahead, 20);
+    } else {
+      EXPECT_EQ(result.composited_ahead, 0);
+    }
   }
   // The keys arrive with some later poll: the first frame with the blue view on the left or the
   // grid is where each run took them (and said so).
@@ -382,6 +392,125 @@ TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessag
   EXPECT_GE(before, 5) << why;
   EXPECT_GE(message, 5) << why;
   EXPECT_GE(after, 5) << why;
+}
+
+// The window, with keys the test types itself: they come with the player's next poll, so the frame
+// rendered after the one a key was typed at is the first one the key may change (keys sent through
+// the X server may take a few polls to arrive).
+class TypedKeysDisplay final : public Display {
+ public:
+  explicit TypedKeysDisplay(std::unique_ptr<Display> inner) : inner_(std::move(inner)) {}
+  void type(KeyPress key) { typed_.push_back(key); }
+
+  std::shared_ptr<gl::Context> context() const override { return inner_->context(); }
+  GLuint packed_framebuffer() const override { return inner_->packed_framebuffer(); }
+  GLuint packed_texture() const override { return inner_->packed_texture(); }
+  std::array<int, 2> packed_size() const override { return inner_->packed_size(); }
+  void present() override { inner_->present(); }
+  double refresh_hz() const override { return inner_->refresh_hz(); }
+  bool vsync() const override { return inner_->vsync(); }
+  std::vector<KeyPress> poll_events() override {
+    std::vector<KeyPress> keys = inner_->poll_events();
+    keys.insert(keys.end(), typed_.begin(), typed_.end());
+    typed_.clear();
+    return keys;
+  }
+  bool close_requested() const override { return inner_->close_requested(); }
+  std::string description() const override { return inner_->description(); }
+
+ private:
+  std::unique_ptr<Display> inner_;
+  std::vector<KeyPress> typed_;
+};
+
+TEST_F(PlayerWindowTest, NoFrameCompositedAheadShowsAStateAKeyHasChanged) {
+  // On the CPU path a worker composites the next queued frames ahead (hmz_output/composite_ahead)
+  // with the state of the moment; a key changes that state while such frames wait. Without
+  // on-screen messages (while one shows, GL draws the frames) the table path goes on right after
+  // the key, so a frame made before it would be seen at once. The clip played on the table path
+  // and on GL, keys typed during both: 's' (swap eyes), 'c' (calibration grid, drawn into the
+  // views), ']' (IPD: new tables for the same views), ← (seek back to the start). Every frame shown
+  // after a key has its effect, and each frame both runs rendered in the same state (keys typed
+  // before it, pts) looks the same. The GL run takes each key 0.3 s earlier, so that the table
+  // run's frames right after its keys, where a stale frame would be, have GL frames to match.
+  const auto clip = make_clip(dir_, 4);
+  PlayerOptions options = silent_options();
+  options.on_screen_messages = false;
+  const auto wanted = stereo_prefilter_block(options.profile, options.compositor, 320, 180, 0.0);
+  ASSERT_TRUE(wanted[0] > 1 || wanted[1] > 1) << "the table needs block means";
+  TypedKeysDisplay display(open_display(options));
+  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
+  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
+  const auto panel = [](const Display& d, const EyeArea& a) {
+    return read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90);
+  };
+  const std::vector<std::pair<double, KeyPress>> keys = {{0.8, KeyPress::of(U's')},
+                                                         {1.4, KeyPress::of(U'c')},
+                                                         {2.0, KeyPress::of(U']')},
+                                                         {2.6, KeyPress::of(KeyPress::Named::left)}};
+  struct Frame {
+    Image left, right;
+  };
+  // [0]: table, [1]: gl; by (keys typed before the frame was rendered, pts).
+  std::map<std::pair<std::size_t, double>, Frame> shown[2];
+  PlayResult results[2];
+  for (int path : {0, 1}) {
+    const ScopedEnv composite("NELF_COMPOSITE", path == 0 ? "table" : "gl");
+    const double lead = path == 1 ? 0.3 : 0.0;
+    std::size_t typed = 0;
+    options.after_render = [&](const Display& d, double pts) {
+      shown[path][{typed, pts}] = Frame{panel(d, left), panel(d, right)};
+      if (typed < keys.size() && pts >= keys[typed].first - lead) display.type(keys[typed++].second);
+    };
+    auto source = open_stereo_frame_source(
+        StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
+    results[path] = play(display, *source, options);
+    EXPECT_EQ(results[path].end, PlayEnd::end_of_file);
+    ASSERT_EQ(typed, keys.size());
+  }
+  // Most frames of the table run came from the worker, none of the GL run's.
+  EXPECT_GE(results[0].composited_ahead * 2, results[0].counters.shown)
+      << results[0].composited_ahead << " of " << results[0].counters.shown;
+  EXPECT_EQ(results[1].composited_ahead, 0);
+
+  std::map<std::size_t, int> compared;
+  int after_seek = 0;
+  for (const auto& [key, table] : shown[0]) {
+    const auto& [typed, pts] = key;
+    SCOPED_TRACE(fmt::format("table frame at {} s after {} keys", pts, typed));
+    const Mean l = mean_of(table.left), r = mean_of(table.right);
+    if (typed == 0) {
+      EXPECT_GT(l.r, l.b + 0.2);  // each eye its own view
+      EXPECT_GT(r.b, r.r + 0.2);
+    } else {
+      EXPECT_GT(r.r - r.b, l.r - l.b + 0.15);  // swapped: the red-ish view on the right
+    }
+    if (typed >= 2) {
+      EXPECT_GT(grid_pixels(table.left), 500);
+      EXPECT_GT(grid_pixels(table.right), 500);
+    } else {
+      EXPECT_EQ(grid_pixels(table.left) + grid_pixels(table.right), 0);
+    }
+    if (typed == 4 && pts < keys[3].first - 0.5) ++after_seek;
+    const auto gl = shown[1].find(key);
+    if (gl == shown[1].end()) continue;
+    ++compared[typed];
+    for (const auto& [a, b] : {std::pair{&table.left, &gl->second.left}, {&table.right, &gl->second.right}}) {
+      double sum = 0.0, worst = 0.0;
+      const std::size_t n = static_cast<std::size_t>(a->width()) * a->height();
+      for (std::size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 4; ++c) {
+          const double d = std::abs(a->data()[i * 4 + c] - b->data()[i * 4 + c]);
+          sum += d;
+          worst = std::max(worst, d);
+        }
+      EXPECT_LT(sum / (4.0 * n), 1.0 / 255);
+      EXPECT_LT(worst, 4.5 / 255);
+    }
+  }
+  EXPECT_GE(after_seek, 20) << "the seek back did not show the start again";
+  for (std::size_t typed = 0; typed <= keys.size(); ++typed)
+    EXPECT_GE(compared[typed], 5) << "too few frames in the same state in both runs after " << typed << " keys";
 }
 
 }  // namespace
