@@ -328,10 +328,10 @@ class PackedFrameRenderer {
   // its eye area); the eyes overwrite all of their own pixels.
   void fill_outside_eyes(std::uint8_t* rgba) const {
     const auto panel = panel_;
-    const std::uint8_t black[4] = {0, 0, 0, 255};
     const auto fill = [&](int y, int from, int to) {
-      for (std::uint8_t* p = rgba + (static_cast<std::size_t>(y) * width_ + from) * 4; from < to; ++from, p += 4)
-        std::memcpy(p, black, 4);
+      if (from < to)
+        fill_opaque_black(
+            {rgba + (static_cast<std::size_t>(y) * width_ + from) * 4, static_cast<std::size_t>(to - from) * 4});
     };
     for (int y = 0; y < height_; ++y) {
       int from = 0;

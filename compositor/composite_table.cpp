@@ -566,6 +566,11 @@ void CompositeTable::render(const std::uint8_t* reduced, std::size_t reduced_str
   }
 }
 
+void fill_opaque_black(std::span<std::uint8_t> rgba) {
+  const std::uint8_t black[4] = {0, 0, 0, 255};
+  for (std::size_t i = 0; i + 4 <= rgba.size(); i += 4) std::memcpy(&rgba[i], black, 4);
+}
+
 void render_packed_eyes(std::array<std::optional<CompositeTable>, 2>& tables,
                         const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride,
                         const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::uint8_t* packed,

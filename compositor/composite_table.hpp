@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -113,6 +114,10 @@ class CompositeTable {
   std::size_t across_row_ = 0;
   std::vector<std::uint8_t> image_;  // the prefiltered image: prefiltered[0] × prefiltered[1], RGBA8, spare rows
 };
+
+// Opaque black RGBA8 (0, 0, 0, 255) over `rgba` (a whole number of pixels): what surrounds the
+// panels in a packed frame.
+void fill_opaque_black(std::span<std::uint8_t> rgba);
 
 // Both eyes of a stereo frame into a packed RGBA8 frame (row 0 the top row, `stride` bytes a row),
 // the two in parallel (each table has its own scratch buffers, so the frame is ready sooner): eye e,

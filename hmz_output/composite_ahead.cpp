@@ -181,8 +181,7 @@ bool CompositeAhead::composite(const CompositeSetup& setup, const StereoVideoFra
   const std::size_t size = stride * static_cast<std::size_t>(setup.packed[1]);
   if (out.pixels.size() != size || out.packed != setup.packed || out.origins != setup.origins) {
     out.pixels.resize(size);
-    const std::uint8_t black[4] = {0, 0, 0, 255};
-    for (std::size_t i = 0; i < size; i += 4) std::memcpy(&out.pixels[i], black, 4);
+    fill_opaque_black(out.pixels);
     out.packed = setup.packed;
     out.origins = setup.origins;
   }

@@ -327,15 +327,14 @@ class PackedRenderer {
     // The textures are filled even when the CPU path will composite this frame: a message or a
     // key changing the optics hands the next render to GL, which then needs them.
     const GLenum type = bits_ > 8 ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE;
-    const bool keep_bytes = may_use_tables();
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     for (int i = 0; i < 2; ++i) {
       const auto& source = i == 0 ? frame.left : frame.right;
       const std::uint8_t* pixels = source.data();
-      if (calibration || keep_bytes) {
-        view_bytes_[i].assign(source.begin(), source.end());
-        if (calibration) draw_over(view_bytes_[i], calibration_grid(i), bits_);
-        pixels = view_bytes_[i].data();
+      if (calibration) {
+        grid_views_[i].assign(source.begin(), source.end());
+        draw_over(grid_views_[i], calibration_grid(i), bits_);
+        pixels = grid_views_[i].data();
       }
       glTextureSubImage2D(views_[i].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, pixels);
     }
@@ -480,12 +479,15 @@ class PackedRenderer {
     if (packed_bytes_.size() != stride * packed[1]) {
       // Black once: the tables write every pixel of the panels, nothing else changes.
       packed_bytes_.resize(stride * packed[1]);
-      const std::uint8_t black[4] = {0, 0, 0, 255};
-      for (std::size_t i = 0; i < packed_bytes_.size(); i += 4) std::memcpy(&packed_bytes_[i], black, 4);
+      fill_opaque_black(packed_bytes_);
     }
+    // The views as uploaded: the frame's own bytes, or the copies with the grid drawn over them.
+    const std::array<const std::uint8_t*, 2> views =
+        calibration_ ? std::array<const std::uint8_t*, 2>{grid_views_[0].data(), grid_views_[1].data()}
+                     : std::array<const std::uint8_t*, 2>{frame_->left.data(), frame_->right.data()};
     const int swap = swap_eyes ? 1 : 0;
-    render_packed_eyes(tables_, {view_bytes_[swap].data(), view_bytes_[1 - swap].data()},
-                       static_cast<std::size_t>(texture_w()) * 4, origins_, packed_bytes_.data(), stride);
+    render_packed_eyes(tables_, {views[swap], views[1 - swap]}, static_cast<std::size_t>(texture_w()) * 4, origins_,
+                       packed_bytes_.data(), stride);
     upload_packed(packed_bytes_.data());
   }
   void upload_packed(const std::uint8_t* pixels) {
@@ -540,10 +542,11 @@ class PackedRenderer {
   std::array<int, 2> grid_block_{1, 1};
   std::array<std::optional<std::pair<int, int>>, 2> origins_;
   std::array<gl::Texture, 2> views_;
-  // The CPU path: the views' bytes as in the textures (calibration grid included), the tables
-  // for the current views and optics (recorded when first used), and the packed frame.
+  // The views with the calibration grid drawn over them, as in the textures while it is on.
+  std::array<std::vector<std::uint8_t>, 2> grid_views_;
+  // The CPU path: the tables for the current views and optics (recorded when first used), and the
+  // packed frame.
   const bool prefer_tables_;
-  std::array<std::vector<std::uint8_t>, 2> view_bytes_;
   std::array<std::optional<CompositeTable>, 2> tables_;
   bool tables_tried_ = false;
   // Compositing ahead: the frame last uploaded and whether with the grid, the worker's copy of the
