@@ -510,14 +510,45 @@ void border_pixel(const CompositeTable::BorderPixel& b, const std::uint8_t* imag
 // RGBA8 intermediate and target hold them. It was float: the only difference is the weights'
 // rounding, which moves a code by one where the exact sum is within ~0.01 of a half (~0.02 % of
 // the eye's values on test charts; against GL the mean difference stays 0.043 codes).
-void CompositeTable::box_pass(const std::uint8_t* reduced, std::size_t reduced_stride) {
+namespace {
+
+// A row of `pixels` block means into `out`: as they are, or with red and blue exchanged (every pass
+// after the first copy is the same for each colour channel, so the eye comes out in that order).
+void copy_means_row(const std::uint8_t* in, std::uint8_t* out, std::size_t pixels, ChannelOrder order) {
+  if (order == ChannelOrder::rgba) {
+    std::memcpy(out, in, pixels * 4);
+    return;
+  }
+  std::size_t i = 0;
+#if defined(__SSE2__)
+  // Little-endian pixels as 32-bit lanes 0xAABBGGRR: keep A and G, move R up and B down.
+  const __m128i green_alpha = _mm_set1_epi32(static_cast<int>(0xFF00FF00u)), low = _mm_set1_epi32(0xFF);
+  for (; i + 4 <= pixels; i += 4) {
+    const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + 4 * i));
+    const __m128i swapped = _mm_or_si128(
+        _mm_and_si128(v, green_alpha),
+        _mm_or_si128(_mm_and_si128(_mm_srli_epi32(v, 16), low), _mm_slli_epi32(_mm_and_si128(v, low), 16)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 4 * i), swapped);
+  }
+#endif
+  for (; i < pixels; ++i) {
+    out[4 * i] = in[4 * i + 2];
+    out[4 * i + 1] = in[4 * i + 1];
+    out[4 * i + 2] = in[4 * i];
+    out[4 * i + 3] = in[4 * i + 3];
+  }
+}
+
+}  // namespace
+
+void CompositeTable::box_pass(const std::uint8_t* reduced, std::size_t reduced_stride, ChannelOrder order) {
   const std::array<int, 2> size = built_.reduced, prefiltered = built_.prefiltered;
   // Along x: a row of block means at a time (copied into input_, whose spare cells the padded pairs
   // may read) → across_ (padded prefiltered width, reduced height).
   const int outputs = static_cast<int>(across_row_ / 4), pairs = horizontal_.pairs;
   for (int y = 0; y < size[1]; ++y) {
-    std::memcpy(input_.data(), reduced + static_cast<std::size_t>(y) * reduced_stride,
-                static_cast<std::size_t>(size[0]) * 4);
+    copy_means_row(reduced + static_cast<std::size_t>(y) * reduced_stride, input_.data(),
+                   static_cast<std::size_t>(size[0]), order);
     std::uint8_t* out = &across_[static_cast<std::size_t>(y) * across_row_];
     const std::int32_t* first = horizontal_.first.data();
     const std::int16_t* weights = horizontal_.weights.data();
@@ -549,8 +580,8 @@ void CompositeTable::box_pass(const std::uint8_t* reduced, std::size_t reduced_s
 }
 
 void CompositeTable::render(const std::uint8_t* reduced, std::size_t reduced_stride, std::uint8_t* out,
-                            std::size_t out_stride) {
-  box_pass(reduced, reduced_stride);
+                            std::size_t out_stride, ChannelOrder order) {
+  box_pass(reduced, reduced_stride, order);
 
   // Pass 1, one bilinear tap per pixel, a row at a time; then pass 2 for the row's pixels along the
   // elemental-image borders (sorted by row) while the row is still in the cache.
@@ -574,13 +605,13 @@ void fill_opaque_black(std::span<std::uint8_t> rgba) {
 void render_packed_eyes(std::array<std::optional<CompositeTable>, 2>& tables,
                         const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride,
                         const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::uint8_t* packed,
-                        std::size_t stride) {
+                        std::size_t stride, ChannelOrder order) {
   const auto render_eye = [&](int e) {
     if (!origins[e] || !tables[e]) return;
     tables[e]->render(views[e], view_stride,
                       packed + static_cast<std::size_t>(origins[e]->second) * stride +
                           static_cast<std::size_t>(origins[e]->first) * 4,
-                      stride);
+                      stride, order);
   };
   auto right = std::async(std::launch::async, render_eye, 1);
   render_eye(0);

@@ -22,6 +22,11 @@
 
 namespace nelf {
 
+// The byte order of a table's output pixels. The block means are always RGBA8; BGRA is what X11
+// and DRM framebuffers hold, so a packed frame made in it goes to the screen by plain copies (on
+// llvmpipe a 1:1 blit between the same formats is a memcpy, a swizzling one a shader pass).
+enum class ChannelOrder { rgba, bgra };
+
 // One axis of the prefilter's separable box pass (shaders/prefilter_box.frag): for each output
 // sample, the input cells it overlaps and their weights (overlap / box width).
 struct BoxAxis {
@@ -87,9 +92,11 @@ class CompositeTable {
   const Built& built() const { return built_; }
 
   // Renders the eye from `reduced` (RGBA8 block means, row 0 the top row, `reduced_stride` bytes
-  // per row) into `out` (the panel-sized eye image, RGBA8, row 0 the top row, `out_stride` bytes
-  // per row; alpha 255). Not thread-safe on one table (scratch buffers); use one per thread.
-  void render(const std::uint8_t* reduced, std::size_t reduced_stride, std::uint8_t* out, std::size_t out_stride);
+  // per row) into `out` (the panel-sized eye image, 8 bits a channel in `order`, row 0 the top row,
+  // `out_stride` bytes per row; alpha 255). Not thread-safe on one table (scratch buffers); use one
+  // per thread.
+  void render(const std::uint8_t* reduced, std::size_t reduced_stride, std::uint8_t* out, std::size_t out_stride,
+              ChannelOrder order = ChannelOrder::rgba);
 
  private:
   // The box pass in fixed point: per output sample of an axis, pairs of input cells with their
@@ -105,7 +112,7 @@ class CompositeTable {
   static Tap make_tap(float x, float y, std::array<int, 2> prefiltered);
   static void replay_taps(const Tap* taps, int count, const std::uint8_t* image, std::size_t image_row,
                           std::uint8_t* out);
-  void box_pass(const std::uint8_t* reduced, std::size_t reduced_stride);
+  void box_pass(const std::uint8_t* reduced, std::size_t reduced_stride, ChannelOrder order);
 
   Built built_;
   FixedAxis horizontal_, vertical_;
@@ -119,13 +126,14 @@ class CompositeTable {
 // panels in a packed frame.
 void fill_opaque_black(std::span<std::uint8_t> rgba);
 
-// Both eyes of a stereo frame into a packed RGBA8 frame (row 0 the top row, `stride` bytes a row),
+// Both eyes of a stereo frame into a packed frame (8 bits a channel in `order`, row 0 the top row,
+// `stride` bytes a row),
 // the two in parallel (each table has its own scratch buffers, so the frame is ready sooner): eye e,
 // when it has a table and an origin, renders views[e] (block means, `view_stride` bytes a row) with
 // its panel's top-left corner at origins[e] (x, y). Pixels outside the panels are left as they are.
 void render_packed_eyes(std::array<std::optional<CompositeTable>, 2>& tables,
                         const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride,
                         const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::uint8_t* packed,
-                        std::size_t stride);
+                        std::size_t stride, ChannelOrder order = ChannelOrder::rgba);
 
 }  // namespace nelf

@@ -177,14 +177,6 @@ bool CompositeAhead::composite(const CompositeSetup& setup, const StereoVideoFra
       frame.block != setup.block || frame.aspect != setup.aspect || frame.left.size() != view_size ||
       frame.right.size() != view_size)
     return false;
-  const std::size_t stride = static_cast<std::size_t>(setup.packed[0]) * 4;
-  const std::size_t size = stride * static_cast<std::size_t>(setup.packed[1]);
-  if (out.pixels.size() != size || out.packed != setup.packed || out.origins != setup.origins) {
-    out.pixels.resize(size);
-    fill_opaque_black(out.pixels);
-    out.packed = setup.packed;
-    out.origins = setup.origins;
-  }
   std::array<const std::uint8_t*, 2> views{frame.left.data(), frame.right.data()};
   if (setup.grid) {
     for (int i = 0; i < 2; ++i) {
@@ -194,10 +186,26 @@ bool CompositeAhead::composite(const CompositeSetup& setup, const StereoVideoFra
       views[i] = views_[i].data();
     }
   }
-  const int swap = setup.swap_eyes ? 1 : 0;
-  render_packed_eyes(*setup.tables, {views[swap], views[1 - swap]}, static_cast<std::size_t>(texture_w) * 4,
-                     setup.origins, out.pixels.data(), stride);
+  render_packed_frame(*setup.tables, views, static_cast<std::size_t>(texture_w) * 4, setup.swap_eyes, setup.origins,
+                      setup.packed, out);
   return true;
+}
+
+void render_packed_frame(std::array<std::optional<CompositeTable>, 2>& tables,
+                         const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride, bool swap_eyes,
+                         const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::array<int, 2> packed,
+                         PackedFrameBytes& out) {
+  const std::size_t stride = static_cast<std::size_t>(packed[0]) * 4;
+  const std::size_t size = stride * static_cast<std::size_t>(packed[1]);
+  if (out.pixels.size() != size || out.packed != packed || out.origins != origins) {
+    out.pixels.resize(size);
+    fill_opaque_black(out.pixels);  // the same bytes in BGRA
+    out.packed = packed;
+    out.origins = origins;
+  }
+  const int swap = swap_eyes ? 1 : 0;
+  render_packed_eyes(tables, {views[swap], views[1 - swap]}, view_stride, origins, out.pixels.data(), stride,
+                     ChannelOrder::bgra);
 }
 
 }  // namespace nelf

@@ -51,19 +51,32 @@ struct CompositeSetup {
   double aspect = 0.0;
 };
 
+// A packed frame made from the tables: BGRA8 (ChannelOrder::bgra: the display's packed texture is
+// BGRA, so uploading and presenting it are copies), row 0 the top row, packed[0]·4 bytes a row; and
+// the layout its pixels around the panels were made black for (the tables write every pixel of the
+// panels, so the memory is made black again only when the panels move).
+struct PackedFrameBytes {
+  std::vector<std::uint8_t> pixels;
+  std::array<int, 2> packed{0, 0};
+  std::array<std::optional<std::pair<int, int>>, 2> origins;
+};
+
+// Both eyes through `tables` into `out` (made packed[0] × packed[1] and black around the panels
+// first, when its layout is another): eye e renders views[e ^ swap_eyes] (8-bit block means,
+// `view_stride` bytes a row) with its panel's top-left corner at origins[e]. What the worker and
+// the display's thread both do with a frame on the CPU path.
+void render_packed_frame(std::array<std::optional<CompositeTable>, 2>& tables,
+                         const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride, bool swap_eyes,
+                         const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::array<int, 2> packed,
+                         PackedFrameBytes& out);
+
 class CompositeAhead {
-  // A packed frame's memory, and the layout the pixels around the panels were made black for: the
-  // tables write every pixel of the panels, so a buffer is cleared only when the panels move.
-  struct Bytes {
-    std::vector<std::uint8_t> pixels;
-    std::array<int, 2> packed{0, 0};
-    std::array<std::optional<std::pair<int, int>>, 2> origins;
-  };
+  using Bytes = PackedFrameBytes;
 
  public:
   using Frame = std::shared_ptr<const StereoVideoFrame>;
 
-  // A packed frame (RGBA8, row 0 the top row, packed[0]·4 bytes a row, black around the panels).
+  // A packed frame (PackedFrameBytes' pixels: BGRA8, row 0 the top row, black around the panels).
   // Its memory goes back to the CompositeAhead it came from, which must outlive it.
   class Packed {
    public:

@@ -60,8 +60,9 @@ class Display {
   // A framebuffer object of options.packed size (row 0 = the packed frame's top row, as everywhere
   // in the compositor) holding the frame that present() shows. Never 0.
   virtual GLuint packed_framebuffer() const = 0;
-  // The GL_RGBA8 colour texture of packed_framebuffer(), for renderers that make the frame on the
-  // CPU (the composite table on software GL) and upload it with glTextureSubImage2D instead.
+  // The 8-bit RGBA colour texture of packed_framebuffer(), stored BGRA where the driver allows
+  // (gl::make_bgra8_texture_2d), for renderers that make the frame on the CPU (the composite table
+  // on software GL) and upload it with glTextureSubImage2D instead: BGRA bytes upload as a copy.
   virtual GLuint packed_texture() const = 0;
   virtual std::array<int, 2> packed_size() const = 0;
 

@@ -423,7 +423,7 @@ void KmsDisplay::init(const DisplayOptions& options) {
   context_->make_current();
   context_->read_renderer();
 
-  texture_ = gl::make_texture_2d(GL_RGBA8, width_, height_);
+  texture_ = gl::make_bgra8_texture_2d(width_, height_);
   fbo_ = gl::make_framebuffer(texture_);
   const GLfloat black[] = {0.f, 0.f, 0.f, 1.f};
   glClearNamedFramebufferfv(fbo_.id(), GL_COLOR, 0, black);

@@ -474,26 +474,19 @@ class PackedRenderer {
   // Both eyes into a CPU copy of the packed frame, then that into the display's texture: one
   // upload of the whole frame, since the eyes' panels are nearly all of it.
   void render_from_tables(bool swap_eyes) {
-    const auto packed = display_.packed_size();
-    const std::size_t stride = static_cast<std::size_t>(packed[0]) * 4;
-    if (packed_bytes_.size() != stride * packed[1]) {
-      // Black once: the tables write every pixel of the panels, nothing else changes.
-      packed_bytes_.resize(stride * packed[1]);
-      fill_opaque_black(packed_bytes_);
-    }
     // The views as uploaded: the frame's own bytes, or the copies with the grid drawn over them.
     const std::array<const std::uint8_t*, 2> views =
         calibration_ ? std::array<const std::uint8_t*, 2>{grid_views_[0].data(), grid_views_[1].data()}
                      : std::array<const std::uint8_t*, 2>{frame_->left.data(), frame_->right.data()};
-    const int swap = swap_eyes ? 1 : 0;
-    render_packed_eyes(tables_, {views[swap], views[1 - swap]}, static_cast<std::size_t>(texture_w()) * 4, origins_,
-                       packed_bytes_.data(), stride);
-    upload_packed(packed_bytes_.data());
+    render_packed_frame(tables_, views, static_cast<std::size_t>(texture_w()) * 4, swap_eyes, origins_,
+                        display_.packed_size(), packed_);
+    upload_packed(packed_.pixels.data());
   }
+  // A BGRA packed frame into the display's (BGRA) texture: a copy.
   void upload_packed(const std::uint8_t* pixels) {
     const auto packed = display_.packed_size();
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTextureSubImage2D(display_.packed_texture(), 0, 0, 0, packed[0], packed[1], GL_RGBA, GL_UNSIGNED_BYTE, pixels);
+    glTextureSubImage2D(display_.packed_texture(), 0, 0, 0, packed[0], packed[1], GL_BGRA, GL_UNSIGNED_BYTE, pixels);
     gl::check_error("uploading the packed frame");
   }
 
@@ -509,7 +502,6 @@ class PackedRenderer {
 
   void rebuild() {
     forget_tables();
-    packed_bytes_.clear();  // the eyes may have moved: black again around them
     compositor_.reset();
     compositor_ = std::make_unique<GlCompositor>(profile_, options_.compositor, display_.context());
     update_wanted_blocks();
@@ -556,7 +548,7 @@ class PackedRenderer {
   std::shared_ptr<std::array<std::optional<CompositeTable>, 2>> worker_tables_;
   std::shared_ptr<const CompositeSetup> setup_;
   const CompositeTableCache table_cache_;
-  std::vector<std::uint8_t> packed_bytes_;
+  PackedFrameBytes packed_;
   int view_w_ = 0, view_h_ = 0, bits_ = 8;
   std::array<int, 2> block_{1, 1};  // of the views in the textures
   std::array<std::array<int, 2>, 2> wanted_blocks_{};

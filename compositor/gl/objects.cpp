@@ -43,16 +43,40 @@ void check_error(std::string_view what) {
   if (error != GL_NO_ERROR) throw GlError(fmt::format("OpenGL error 0x{:x} in {}", error, what));
 }
 
+namespace {
+void set_linear_clamp(GLuint id) {
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+}  // namespace
+
 Texture make_texture_2d(GLenum internal_format, int width, int height) {
   GLuint id = 0;
   glCreateTextures(GL_TEXTURE_2D, 1, &id);
   Texture texture(id);
   glTextureStorage2D(id, 1, internal_format, width, height);
-  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  set_linear_clamp(id);
   check_error(fmt::format("creating a {}x{} texture", width, height));
+  return texture;
+}
+
+Texture make_bgra8_texture_2d(int width, int height) {
+  GLuint id = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &id);
+  Texture texture(id);
+  // Mesa picks the storage from the first specification's format when the internal format is
+  // unsized (GL_RGBA with GL_BGRA data: B8G8R8A8); sized GL_RGBA8, or glTextureStorage2D, gives
+  // R8G8B8A8. Mutable storage, then, with one level.
+  GLint bound = 0;
+  glGetIntegerv(GL_TEXTURE_BINDING_2D, &bound);
+  glBindTexture(GL_TEXTURE_2D, id);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA, width, height, 0, GL_BGRA, GL_UNSIGNED_BYTE, nullptr);
+  glBindTexture(GL_TEXTURE_2D, static_cast<GLuint>(bound));
+  glTextureParameteri(id, GL_TEXTURE_MAX_LEVEL, 0);
+  set_linear_clamp(id);
+  check_error(fmt::format("creating a {}x{} BGRA texture", width, height));
   return texture;
 }
 

@@ -54,11 +54,13 @@ CompositeAhead::Frame make_frame(double pts, Pixel left, Pixel right, int width 
   return f;
 }
 
+// The packed frame's BGRA pixels, as RGBA.
 std::array<Pixel, 3> pixels_of(const CompositeAhead::Packed& packed) {
   EXPECT_EQ(packed.size(), 12u);
   std::array<Pixel, 3> out{};
+  constexpr std::array<int, 4> byte_of{2, 1, 0, 3};
   for (int x = 0; x < 3; ++x)
-    for (int c = 0; c < 4; ++c) out[x][c] = packed.data()[x * 4 + c];
+    for (int c = 0; c < 4; ++c) out[x][c] = packed.data()[x * 4 + byte_of[c]];
   return out;
 }
 

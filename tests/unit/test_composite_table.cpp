@@ -31,7 +31,7 @@ CompositeTable::Recording test_recording() {
     float u = uniform(rng), v = uniform(rng);
     if (i % 7 == 0) u = (static_cast<float>(i % 17) + 0.5f) / 17.f, v = (static_cast<float>(i % 10) + 0.5f) / 10.f;
     if (i % 13 == 0) v = (static_cast<float>(i % 9) + 1.499f) / 10.f;  // a thousandth above a texel's centre
-    if (i % 11 == 0) u = -1.f;  // black
+    if (i % 11 == 0) u = -1.f;                                         // black
     r.coordinates.push_back(u), r.coordinates.push_back(v);
   }
   for (int p : {0, 5, 38, 40, 77, 200, 350}) {
@@ -183,6 +183,33 @@ TEST(CompositeTable, TapsAtTexelCentresAreThoseTexels) {
   EXPECT_EQ(taps[1].weights, (std::array<std::uint8_t, 4>{0, 0, 0, 0}));
   EXPECT_EQ(taps[3].texel, 2);  // moved down to the texel that has all the weight
   EXPECT_EQ(taps[3].weights, (std::array<std::uint8_t, 4>{0, 0, 0, 0}));
+}
+
+// ChannelOrder::bgra (the player's packed frames): the same eye, red and blue exchanged, byte for
+// byte, on a view 20 means wide (the SIMD copy) and one 2 wide (the scalar one).
+TEST(CompositeTable, InBgraOrderItIsTheRgbaEyeWithRedAndBlueExchanged) {
+  CompositeTable::Recording small;
+  small.panel = {4, 1};
+  small.reduced = {2, 2};
+  small.prefiltered = {2, 2};
+  small.horizontal = make_box_axis(2, 0.0, 1.0, 1.0, 1.0, 2, 2.0);
+  small.vertical = make_box_axis(2, 0.0, 1.0, 1.0, 1.0, 2, 2.0);
+  small.coordinates = {0.25f, 0.25f, 0.75f, 0.75f, 0.4f, 0.6f, 0.3f, 0.7f};
+  for (const CompositeTable::Recording& r : {test_recording(), small}) {
+    CompositeTable table(r);
+    Bytes means(static_cast<std::size_t>(r.reduced[0]) * r.reduced[1] * 4);
+    std::mt19937 rng(5);
+    for (auto& m : means) m = static_cast<std::uint8_t>(rng());
+    const std::size_t stride = static_cast<std::size_t>(r.panel[0]) * 4 + 4;
+    Bytes rgba(stride * r.panel[1], 77), bgra(stride * r.panel[1], 77);
+    table.render(means.data(), static_cast<std::size_t>(r.reduced[0]) * 4, rgba.data(), stride, ChannelOrder::rgba);
+    table.render(means.data(), static_cast<std::size_t>(r.reduced[0]) * 4, bgra.data(), stride, ChannelOrder::bgra);
+    Bytes exchanged = rgba;
+    for (int y = 0; y < r.panel[1]; ++y)
+      for (int x = 0; x < r.panel[0]; ++x) std::swap(exchanged[y * stride + x * 4], exchanged[y * stride + x * 4 + 2]);
+    EXPECT_EQ(bgra, exchanged) << "panel " << r.panel[0] << "x" << r.panel[1];
+    EXPECT_NE(bgra, rgba);
+  }
 }
 
 }  // namespace
