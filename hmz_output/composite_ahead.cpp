@@ -1,5 +1,7 @@
 #include "hmz_output/composite_ahead.hpp"
 
+#include "hmz_output/calibration_overlay.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -8,27 +10,6 @@
 #include <unistd.h>
 
 namespace nelf {
-
-void draw_over(std::vector<std::uint8_t>& pixels, const Image& cover, int bits) {
-  const std::size_t n = static_cast<std::size_t>(cover.width()) * cover.height();
-  const float* p = cover.data();
-  for (std::size_t i = 0; i < n; ++i) {
-    const float a = p[i * 4 + 3];
-    if (a <= 0.f) continue;
-    for (std::size_t c = 0; c < 3; ++c) {
-      const float grid = std::clamp(p[i * 4 + c], 0.f, 1.f);
-      if (bits > 8) {
-        std::uint16_t u = 0;
-        std::memcpy(&u, &pixels[i * 8 + c * 2], 2);
-        u = static_cast<std::uint16_t>(std::lround((u / 65535.f * (1.f - a) + grid * a) * 65535.f));
-        std::memcpy(&pixels[i * 8 + c * 2], &u, 2);
-      } else {
-        pixels[i * 4 + c] =
-            static_cast<std::uint8_t>(std::lround((pixels[i * 4 + c] / 255.f * (1.f - a) + grid * a) * 255.f));
-      }
-    }
-  }
-}
 
 CompositeAhead::Packed::Packed(CompositeAhead* owner, std::unique_ptr<Bytes> bytes)
     : owner_(owner), bytes_(std::move(bytes)) {}

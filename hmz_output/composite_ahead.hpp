@@ -32,10 +32,6 @@
 
 namespace nelf {
 
-// The calibration overlay drawn over view bytes (`bits` 8 or 16): where `cover`'s alpha is 1 the
-// grid replaces the view, where 0 the view shows through (the player's cover_grid).
-void draw_over(std::vector<std::uint8_t>& pixels, const Image& cover, int bits);
-
 // Everything a packed frame made from the tables depends on besides the frame itself. Shared
 // read-only between the display's thread, which makes it, and the worker, except `tables`: their
 // render() uses scratch buffers, so they are the worker's own copy, rendered only by the worker.
@@ -115,8 +111,8 @@ class CompositeAhead {
 
   // Packed frames in memory (the pool, finished frames, the one being made, those handed out).
   std::size_t buffers() const;
-  // Diagnostics and tests: waits (up to `timeout`) until the worker has nothing it can do; then
-  // how many of the wanted frames are made.
+  // Waits (up to `timeout`) until the worker has nothing it can do (the player, before its clock
+  // starts; tests); then how many of the wanted frames are made.
   std::size_t wait_until_idle(std::chrono::milliseconds timeout);
 
  private:

@@ -22,6 +22,7 @@
 #include "compositor/image_library.hpp"
 #include "compositor/text_overlay.hpp"
 #include "hmz_output/audio_output.hpp"
+#include "hmz_output/calibration_overlay.hpp"
 #include "hmz_output/composite_ahead.hpp"
 #include "hmz_output/packing.hpp"
 #include "inputs/audio_source.hpp"
@@ -249,42 +250,14 @@ class AudioFeeder {
   std::jthread thread_;  // last: stops before the members it uses go
 };
 
-// The calibration overlay is `nelf calibrate`'s grid pattern (lines 16 cells across, a yellow
-// centre cross, the eye's letter) drawn over the view (draw_over, hmz_output/composite_ahead), so
-// that the eyes' alignment and the lens grid can be judged on the movie itself.
-//
-// The full-size grid `pattern` as drawn over block means of `block` pixels: per block, alpha = the
-// share of its pixels the grid covers (not black), colour = their mean. Blending that over the
-// block mean of the movie gives exactly the block mean of the grid drawn over the full view, so
-// the lines look as they do without the reduction (at 1×1: the grid as is, alpha 0 or 1).
-Image cover_grid(const Image& pattern, std::array<int, 2> block) {
-  Image out(pattern.width() / block[0], pattern.height() / block[1]);
-  const float per_block = 1.f / static_cast<float>(block[0] * block[1]);
-  for (int y = 0; y < out.height(); ++y)
-    for (int x = 0; x < out.width(); ++x) {
-      Rgba sum{0.f, 0.f, 0.f, 0.f};
-      for (int by = 0; by < block[1]; ++by)
-        for (int bx = 0; bx < block[0]; ++bx) {
-          const Rgba& q = pattern.at(x * block[0] + bx, y * block[1] + by);
-          if (std::max({q.r, q.g, q.b}) < 0.02f) continue;  // black: the movie shows through
-          sum.r += q.r;
-          sum.g += q.g;
-          sum.b += q.b;
-          sum.a += 1.f;
-        }
-      Rgba& o = out.at(x, y);
-      o = sum.a > 0.f ? Rgba{sum.r / sum.a, sum.g / sum.a, sum.b / sum.a, sum.a * per_block} : Rgba{0.f, 0.f, 0.f, 0.f};
-    }
-  return out;
-}
-
 // The GL side: view textures, the compositor (rebuilt when the optics change) and the eye areas;
 // on software GL also the CPU path, composite tables replayed from the views' bytes.
 class PackedRenderer {
  public:
-  // Frames composited ahead: two cover a slow composite (40 ms) at 30 fps, with three packed frames
-  // (7.5 MB each at 720p frame packing) in memory.
-  static constexpr std::size_t ahead_depth = 2;
+  // Frames composited ahead: three, with four packed frames (7.5 MB each at 720p frame packing) in
+  // memory. With a busy process beside the player on two cores, 30 fps dropped 8 of 300 frames a
+  // run with two ahead and 3 with three (10 runs each); on a quiet machine both drop none.
+  static constexpr std::size_t ahead_depth = 3;
 
   PackedRenderer(Display& display, const PlayerOptions& options)
       : display_(display), options_(options), prefer_tables_(prefer_composite_table(*display.context())) {
@@ -405,6 +378,8 @@ class PackedRenderer {
   void composite_ahead(bool swap_eyes, std::span<const CompositeAhead::Frame> frames) {
     ahead_.want(ahead_setup(swap_eyes), frames);
   }
+  // Waits (up to `timeout`) until the worker has made what it was asked for.
+  void wait_for_ahead(std::chrono::milliseconds timeout) { ahead_.wait_until_idle(timeout); }
 
  private:
   // The CPU path (compositor/composite_table.hpp) replays the fsaa-1 composite of 8-bit block
@@ -727,6 +702,16 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     }
   };
 
+  // Before the clock starts (after the first frame) or restarts (after a seek): the next frames
+  // composited ahead, waiting up to 0.3 s. The worker's first frames take 40 ms and more (new
+  // buffers, cold caches), and with the clock running the first refreshes dropped frames waiting
+  // for them (2 of 300 at 30 fps in a run of tests/bench/play_pacing.sh).
+  auto prime_ahead = [&] {
+    const std::vector<FrameQueue::Frame> next = queue.front(queue_capacity);
+    renderer.composite_ahead(swap_eyes, next);
+    renderer.wait_for_ahead(std::chrono::milliseconds(300));
+  };
+
   // Wait (briefly) for the first frame so the clock does not run ahead of a slow start.
   while (!queue.wait_for_frame(std::chrono::milliseconds(50))) {
     bool end = false;
@@ -799,7 +784,10 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     if (awaiting_seek && (!queued.empty() || end)) {
       awaiting_seek = false;
       show_while_paused = paused;
-      if (!paused) clock->set_paused(false);
+      if (!paused) {
+        prime_ahead();
+        clock->set_paused(false);
+      }
     }
     bool finished = false;
     if (!awaiting_seek && (!(paused && started) || show_while_paused)) {
@@ -858,7 +846,10 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
       }
       if (!started) {
         started = true;
-        if (!paused && !awaiting_seek) clock->set_paused(false);
+        if (!paused && !awaiting_seek) {
+          prime_ahead();
+          clock->set_paused(false);
+        }
       }
       if (!event) event = "redrawn";
     } else if (display.vsync()) {
