@@ -8,6 +8,7 @@
 
 #include <array>
 #include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <stdexcept>
 #include <thread>
@@ -77,6 +78,37 @@ TEST_F(WindowDisplayTest, ShowsThePackedFrameOneToOneWhenItFitsTopRowAtTheTop) {
   EXPECT_EQ(screen.at(639, 1469), blue);
   EXPECT_EQ(screen.at(640, 735), white);
   EXPECT_EQ(screen.at(1279, 1469), white);
+}
+
+// What the player's CPU path does: a packed frame made in BGRA bytes (ChannelOrder::bgra, row 0 the
+// top row) uploaded into packed_texture() as GL_BGRA. Its colours reach the window as they are (on
+// llvmpipe upload and 1:1 blit are then plain copies; a wrong order would swap red and blue).
+TEST_F(WindowDisplayTest, ABgraPackedFrameUploadedIntoThePackedTextureShowsItsColours) {
+  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  const auto [w, h] = display->packed_size();
+  const std::array<Rgb, 4> colours{{{200, 40, 30}, {20, 160, 90}, {10, 60, 230}, {250, 250, 5}}};
+  std::vector<std::uint8_t> bgra(static_cast<std::size_t>(w) * h * 4);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const Rgb& c = colours[(y < h / 2 ? 0 : 2) + (x < w / 2 ? 0 : 1)];
+      std::uint8_t* p = &bgra[(static_cast<std::size_t>(y) * w + x) * 4];
+      p[0] = static_cast<std::uint8_t>(c[2]);
+      p[1] = static_cast<std::uint8_t>(c[1]);
+      p[2] = static_cast<std::uint8_t>(c[0]);
+      p[3] = 255;
+    }
+  glTextureSubImage2D(display->packed_texture(), 0, 0, 0, w, h, GL_BGRA, GL_UNSIGNED_BYTE, bgra.data());
+  ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+  display->present();
+  const test::WindowCapture screen = read_window();
+  ASSERT_EQ(screen.width, w);
+  ASSERT_EQ(screen.height, h);
+  EXPECT_EQ(screen.at(0, 0), colours[0]);
+  EXPECT_EQ(screen.at(w - 1, 0), colours[1]);
+  EXPECT_EQ(screen.at(0, h - 1), colours[2]);
+  EXPECT_EQ(screen.at(w - 1, h - 1), colours[3]);
+  EXPECT_EQ(screen.at(w / 2 - 1, h / 2 - 1), colours[0]);
+  EXPECT_EQ(screen.at(w / 2, h / 2), colours[3]);
 }
 
 TEST_F(WindowDisplayTest, ScalesToFitAResizedWindowWithBlackBars) {
