@@ -255,8 +255,8 @@ class AudioFeeder {
 class PackedRenderer {
  public:
   // Frames composited ahead: three, with four packed frames (7.5 MB each at 720p frame packing) in
-  // memory. With a busy process beside the player on two cores, 30 fps dropped 8 of 300 frames a
-  // run with two ahead and 3 with three (10 runs each); on a quiet machine both drop none.
+  // memory. With a busy process beside the player on two cores, ten 30 fps runs dropped 17 frames
+  // in all with two ahead and 8 with three; on a quiet machine both drop none.
   static constexpr std::size_t ahead_depth = 3;
 
   PackedRenderer(Display& display, const PlayerOptions& options)
