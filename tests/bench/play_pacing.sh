@@ -12,6 +12,8 @@
 #   FSAA     --fsaa for play (default 1)
 #   PROFILE  the device profile (default hmz-t1)
 # With PACING_LOGS=DIR the frame logs are kept there as log24.csv, log30.csv, log60.csv.
+# PACING_SCREEN=WxH sets the Xvfb screen (default 1920x1600, where the 1280x1470 window fits 1:1;
+# 1920x1080 gives a window scaled to fit, as on a 1080p desktop).
 set -euo pipefail
 nelf=$(realpath "${1:-build/nelf}")
 seconds=${2:-10}
@@ -32,11 +34,12 @@ export NELF_CACHE_DIR=$work/nelf-cache  # composite tables: recorded on the firs
 
 # A private X server on a free display number (Xvfb writes it to the fd we give it).
 exec {displayfd}<> <(:)
-Xvfb -displayfd "$displayfd" -screen 0 1920x1600x24 -nolisten tcp -noreset >/dev/null 2>&1 &
+Xvfb -displayfd "$displayfd" -screen 0 "${PACING_SCREEN:-1920x1600}x24" -nolisten tcp -noreset >/dev/null 2>&1 &
 xvfb_pid=$!
 read -r -t 10 display_number <&"$displayfd"
 export DISPLAY=:$display_number
 
+echo "screen: ${PACING_SCREEN:-1920x1600}"
 echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg), LP_NUM_THREADS=$LP_NUM_THREADS"
 echo "command: nelf play CLIP --profile $profile --signal hdmi-fp-720p60 --fsaa $fsaa --log-frames LOG (DISPLAY=$DISPLAY, SDL_AUDIODRIVER=$SDL_AUDIODRIVER)"
 printf '| source | frames | shown | repeated | dropped | upload ms | composite ms | present ms | late >1 frame |\n'
