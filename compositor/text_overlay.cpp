@@ -51,8 +51,8 @@ TextOverlay::~TextOverlay() = default;
 
 void TextOverlay::set_text(std::string text) { text_ = std::move(text); }
 
-const TextOverlay::Label& TextOverlay::label(int font_px) {
-  if (label_.texture && label_.text == text_ && label_.font_px == font_px) return label_;
+const TextOverlay::Label& TextOverlay::cpu_label(int font_px) {
+  if (!label_.rgba.empty() && label_.text == text_ && label_.font_px == font_px) return label_;
   const std::string font = chart::font();
   const auto extent = image_library::text_size(text_, font_px, font);
   if (!extent)
@@ -74,19 +74,72 @@ const TextOverlay::Label& TextOverlay::label(int font_px) {
   } catch (const image_library::ImageLibraryError& e) {
     throw std::runtime_error(fmt::format("cannot render the on-screen text: {}", e.what()));
   }
-  std::vector<unsigned char> pixels(image.size());
+  label_.rgba.resize(image.size());
   for (std::size_t i = 0; i < image.size(); ++i)
-    pixels[i] = static_cast<unsigned char>(std::lround(std::clamp(image[i], 0.f, 1.f) * 255.f));
-
-  label_.texture = gl::make_texture_2d(GL_RGBA8, width, height);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glTextureSubImage2D(label_.texture.id(), 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
-  gl::check_error("uploading the on-screen text");
+    label_.rgba[i] = static_cast<std::uint8_t>(std::lround(std::clamp(image[i], 0.f, 1.f) * 255.f));
+  label_.texture.reset();  // for the old text
   label_.text = text_;
   label_.font_px = font_px;
   label_.width = width;
   label_.height = height;
   return label_;
+}
+
+const TextOverlay::Label& TextOverlay::label(int font_px) {
+  const Label& made = cpu_label(font_px);
+  if (made.texture) return made;
+  label_.texture = gl::make_texture_2d(GL_RGBA8, made.width, made.height);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(label_.texture.id(), 0, 0, 0, made.width, made.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                      made.rgba.data());
+  gl::check_error("uploading the on-screen text");
+  return label_;
+}
+
+TextOverlay::Placement TextOverlay::place(int width, int height, double aspect) {
+  // Size: from the view's height; smaller when the line would not fit the width.
+  int font_px = std::max(kMinimumFontPx, static_cast<int>(std::lround(height * kFontPerViewHeight)));
+  const Label* text = &cpu_label(font_px);
+  const double widest = kMaximumWidthFraction * width * aspect;  // in square (label) pixels
+  if (text->width > widest) {
+    font_px = std::max(kMinimumFontPx, static_cast<int>(std::floor(font_px * widest / text->width)));
+    text = &cpu_label(font_px);
+  }
+  Box box;
+  box.width = std::min(width, std::max(1, static_cast<int>(std::lround(text->width / aspect))));
+  box.height = std::min(height, text->height);
+  box.x = (width - box.width) / 2;
+  box.y =
+      std::clamp(static_cast<int>(std::lround(kBoxCentreFromTop * height - box.height / 2.0)), 0, height - box.height);
+  return {font_px, box};
+}
+
+Image TextOverlay::cover(int width, int height, double aspect) {
+  if (text_.empty() || width <= 0 || height <= 0) return Image();
+  const Placement at = place(width, height, pixel_aspect(GlTextureView{0, width, height, aspect}));
+  const Label& text = cpu_label(at.font_px);
+  Image out(width, height);
+  std::fill_n(out.data(), static_cast<std::size_t>(width) * height * 4, 0.f);  // transparent outside the box
+  // text_overlay.frag's texture() of the label at each box texel's centre: bilinear, clamped to
+  // the edge, from the label's 8-bit values.
+  const auto texel = [&](int x, int y, int c) {
+    x = std::clamp(x, 0, text.width - 1);
+    y = std::clamp(y, 0, text.height - 1);
+    return text.rgba[(static_cast<std::size_t>(y) * text.width + x) * 4 + c] / 255.f;
+  };
+  for (int y = 0; y < at.box.height; ++y)
+    for (int x = 0; x < at.box.width; ++x) {
+      const float u = (x + 0.5f) / at.box.width * text.width - 0.5f;
+      const float v = (y + 0.5f) / at.box.height * text.height - 0.5f;
+      const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
+      const float fx = u - x0, fy = v - y0;
+      float value[4];
+      for (int c = 0; c < 4; ++c)
+        value[c] = (texel(x0, y0, c) * (1 - fx) + texel(x0 + 1, y0, c) * fx) * (1 - fy) +
+                   (texel(x0, y0 + 1, c) * (1 - fx) + texel(x0 + 1, y0 + 1, c) * fx) * fy;
+      out.at(at.box.x + x, at.box.y + y) = Rgba{value[0], value[1], value[2], value[3]};
+    }
+  return out;
 }
 
 GlTextureView TextOverlay::apply(Eye eye, const GlTextureView& view) {
@@ -106,21 +159,9 @@ GlTextureView TextOverlay::apply(Eye eye, const GlTextureView& view) {
     target.format = format;
   }
 
-  // Size: from the view's height; smaller when the line would not fit the width.
-  const double aspect = pixel_aspect(view);
-  int font_px = std::max(kMinimumFontPx, static_cast<int>(std::lround(view.height * kFontPerViewHeight)));
-  const Label* text = &label(font_px);
-  const double widest = kMaximumWidthFraction * view.width * aspect;  // in square (label) pixels
-  if (text->width > widest) {
-    font_px = std::max(kMinimumFontPx, static_cast<int>(std::floor(font_px * widest / text->width)));
-    text = &label(font_px);
-  }
-  Box box;
-  box.width = std::min(view.width, std::max(1, static_cast<int>(std::lround(text->width / aspect))));
-  box.height = std::min(view.height, text->height);
-  box.x = (view.width - box.width) / 2;
-  box.y = std::clamp(static_cast<int>(std::lround(kBoxCentreFromTop * view.height - box.height / 2.0)), 0,
-                     view.height - box.height);
+  const Placement at = place(view.width, view.height, pixel_aspect(view));
+  const Label* text = &label(at.font_px);
+  const Box box = at.box;
 
   glBindFramebuffer(GL_FRAMEBUFFER, target.fbo.id());
   if (format == static_cast<GLenum>(view_format)) {

@@ -5,11 +5,14 @@
 #include <epoxy/gl.h>
 
 #include <array>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "compositor/compositor.hpp"
 #include "compositor/gl/objects.hpp"
 #include "compositor/gl_compositor.hpp"
+#include "compositor/image.hpp"
 
 namespace nelf {
 
@@ -44,13 +47,29 @@ class TextOverlay {
   // The box of the last apply() for `eye` (all zero when the text was empty).
   Box box(Eye eye) const { return eyes_[static_cast<int>(eye)].box; }
 
+  // The same text for views whose bytes are composited on the CPU (the player's composite
+  // tables): a width × height image of the label as apply() draws it into such a view (`aspect`
+  // its display aspect, 0 = width / height), alpha 0 outside the box; drawn over the view's bytes
+  // (draw_over, hmz_output/calibration_overlay) it gives what apply() gives. Empty for no text.
+  // Needs no GL. Throws std::runtime_error when the text cannot be rendered (no font).
+  Image cover(int width, int height, double aspect);
+
  private:
   struct Label {
     std::string text;
     int font_px = 0;
     int width = 0, height = 0;
-    gl::Texture texture;
+    std::vector<std::uint8_t> rgba;  // as in `texture` (RGBA8, row 0 the top row)
+    gl::Texture texture;             // made by label(), not by cpu_label()
   };
+  // Where the label goes in a view (font size narrowed to fit its width) and at which size.
+  struct Placement {
+    int font_px = 0;
+    Box box;
+  };
+  Placement place(int width, int height, double pixel_aspect);
+  // The label's pixels for `text_` at `font_px` (cached; no GL).
+  const Label& cpu_label(int font_px);
   struct EyeTarget {
     int width = 0, height = 0;
     GLenum format = 0;

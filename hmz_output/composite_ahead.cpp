@@ -158,18 +158,22 @@ bool CompositeAhead::composite(const CompositeSetup& setup, const StereoVideoFra
       frame.block != setup.block || frame.aspect != setup.aspect || frame.left.size() != view_size ||
       frame.right.size() != view_size)
     return false;
-  std::array<const std::uint8_t*, 2> views{frame.left.data(), frame.right.data()};
-  if (setup.grid) {
-    for (int i = 0; i < 2; ++i) {
-      const auto& source = i == 0 ? frame.left : frame.right;
-      views_[i].assign(source.begin(), source.end());
-      draw_over(views_[i], (*setup.grid)[static_cast<std::size_t>(i)], 8);
-      views[i] = views_[i].data();
-    }
-  }
+  std::array<const std::uint8_t*, 2> views{};
+  for (std::size_t i = 0; i < 2; ++i)
+    views[i] = covered_view(i == 0 ? frame.left : frame.right, setup.grid ? &(*setup.grid)[i] : nullptr,
+                            setup.message.get(), views_[i]);
   render_packed_frame(*setup.tables, views, static_cast<std::size_t>(texture_w) * 4, setup.swap_eyes, setup.origins,
                       setup.packed, out);
   return true;
+}
+
+const std::uint8_t* covered_view(std::span<const std::uint8_t> view, const Image* grid, const Image* message,
+                                 std::vector<std::uint8_t>& scratch) {
+  if (!grid && !message) return view.data();
+  scratch.assign(view.begin(), view.end());
+  if (grid) draw_over(scratch, *grid, 8);
+  if (message) draw_over(scratch, *message, 8);
+  return scratch.data();
 }
 
 void render_packed_frame(std::array<std::optional<CompositeTable>, 2>& tables,

@@ -45,7 +45,14 @@ struct CompositeSetup {
   int view_width = 0, view_height = 0;
   std::array<int, 2> block{1, 1};
   double aspect = 0.0;
+  // The on-screen message over both views, after the grid (TextOverlay::cover), or none.
+  std::shared_ptr<const Image> message;
 };
+
+// The bytes a view is composited from: `view` itself, or, with a calibration `grid` or a `message`
+// cover (either may be null), a copy in `scratch` with the grid and then the message drawn over it.
+const std::uint8_t* covered_view(std::span<const std::uint8_t> view, const Image* grid, const Image* message,
+                                 std::vector<std::uint8_t>& scratch);
 
 // A packed frame made from the tables: BGRA8 (ChannelOrder::bgra: the display's packed texture is
 // BGRA, so uploading and presenting it are copies), row 0 the top row, packed[0]·4 bytes a row; and
@@ -141,7 +148,7 @@ class CompositeAhead {
   const CompositeSetup* in_hand_setup_ = nullptr;
   std::vector<std::unique_ptr<Bytes>> pool_;
   std::size_t buffers_ = 0;
-  // The worker's scratch: the views with the calibration grid drawn over them.
+  // The worker's scratch: the views with the calibration grid and the message drawn over them.
   std::array<std::vector<std::uint8_t>, 2> views_;
   std::jthread worker_;  // last: stops before the members it uses go
 };

@@ -297,8 +297,9 @@ class PackedRenderer {
       update_wanted_blocks();
       forget_tables();
     }
-    // The textures are filled even when the CPU path will composite this frame: a message or a
-    // key changing the optics hands the next render to GL, which then needs them.
+    // The textures are filled even when the CPU path will composite this frame: a key changing
+    // the optics hands the next renders to GL (until block means for the new optics arrive),
+    // which then needs them.
     const GLenum type = bits_ > 8 ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     for (int i = 0; i < 2; ++i) {
@@ -386,12 +387,12 @@ class PackedRenderer {
   // means several times cheaper than llvmpipe runs the GL passes; prefer_composite_table says
   // where it pays (software GL, or NELF_COMPOSITE).
   bool may_use_tables() const { return prefer_tables_ && bits_ == 8 && reduced(); }
-  // Whether this render goes the CPU path: not while a message shows (the overlay is drawn with
-  // GL onto the view textures), nor with block means made for optics a key has changed since
-  // (the GL path's smaller view covers the frames until the new block arrives). Records the
-  // tables on first use for the current views and optics.
+  // Whether this render goes the CPU path: not with block means made for optics a key has changed
+  // since (the GL path's smaller view covers the frames until the new block arrives). A message
+  // goes into the views' bytes (message_cover). Records the tables on first use for the current
+  // views and optics.
   bool table_path_open() const {
-    if (view_w_ == 0 || !may_use_tables() || !overlay_.text().empty()) return false;
+    if (view_w_ == 0 || !may_use_tables()) return false;
     for (Eye eye : {Eye::left, Eye::right})
       if (origins_[static_cast<int>(eye)] && block_ != wanted_block(eye)) return false;
     return true;
@@ -438,21 +439,46 @@ class PackedRenderer {
       }
       grid = grid_;
     }
-    if (!setup_ || setup_->swap_eyes != swap_eyes || setup_->grid != grid) {
+    std::shared_ptr<const Image> message;
+    try {
+      message = message_cover();
+    } catch (const std::runtime_error&) {
+      return nullptr;  // no font: render() says so
+    }
+    if (!setup_ || setup_->swap_eyes != swap_eyes || setup_->grid != grid || setup_->message != message) {
       // The worker's own copy (once per tables): a table's render() uses its scratch buffers.
       if (!worker_tables_) worker_tables_ = std::make_shared<std::array<std::optional<CompositeTable>, 2>>(tables_);
-      setup_ = std::make_shared<const CompositeSetup>(CompositeSetup{
-          worker_tables_, origins_, display_.packed_size(), swap_eyes, grid, view_w_, view_h_, block_, aspect_});
+      setup_ = std::make_shared<const CompositeSetup>(CompositeSetup{worker_tables_, origins_, display_.packed_size(),
+                                                                     swap_eyes, grid, view_w_, view_h_, block_, aspect_,
+                                                                     message});
     }
     return setup_;
+  }
+  // The message as a cover for the views' bytes (what overlay_.apply() draws into the view
+  // textures on the GL path), or null for none. Made when the text or the views change.
+  std::shared_ptr<const Image> message_cover() {
+    if (overlay_.text().empty()) return nullptr;
+    const double aspect = aspect_ > 0.0 ? aspect_ : static_cast<double>(view_w_) / view_h_;
+    if (!message_ || message_text_ != overlay_.text() || message_->width() != texture_w() ||
+        message_->height() != texture_h() || message_aspect_ != aspect) {
+      message_ = std::make_shared<const Image>(overlay_.cover(texture_w(), texture_h(), aspect));
+      message_text_ = overlay_.text();
+      message_aspect_ = aspect;
+    }
+    return message_;
   }
   // Both eyes into a CPU copy of the packed frame, then that into the display's texture: one
   // upload of the whole frame, since the eyes' panels are nearly all of it.
   void render_from_tables(bool swap_eyes) {
     // The views as uploaded: the frame's own bytes, or the copies with the grid drawn over them.
-    const std::array<const std::uint8_t*, 2> views =
+    std::array<const std::uint8_t*, 2> views =
         calibration_ ? std::array<const std::uint8_t*, 2>{grid_views_[0].data(), grid_views_[1].data()}
                      : std::array<const std::uint8_t*, 2>{frame_->left.data(), frame_->right.data()};
+    // The message over them, as the GL path draws it over the textures.
+    const auto message = message_cover();
+    const std::size_t view_bytes = static_cast<std::size_t>(texture_w()) * texture_h() * 4;
+    for (std::size_t i = 0; i < 2; ++i)
+      views[i] = covered_view({views[i], view_bytes}, nullptr, message.get(), message_views_[i]);
     render_packed_frame(tables_, views, static_cast<std::size_t>(texture_w()) * 4, swap_eyes, origins_,
                         display_.packed_size(), packed_);
     upload_packed(packed_.pixels.data());
@@ -511,6 +537,12 @@ class PackedRenderer {
   std::array<gl::Texture, 2> views_;
   // The views with the calibration grid drawn over them, as in the textures while it is on.
   std::array<std::vector<std::uint8_t>, 2> grid_views_;
+  // The message as a cover for the views' bytes (CPU path), what it was made for, and the views
+  // with it drawn over them.
+  std::shared_ptr<const Image> message_;
+  std::string message_text_;
+  double message_aspect_ = 0.0;
+  std::array<std::vector<std::uint8_t>, 2> message_views_;
   // The CPU path: the tables for the current views and optics (recorded when first used), and the
   // packed frame.
   const bool prefer_tables_;

@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "compositor/text_overlay.hpp"
 #include "gl/gl_test_support.hpp"
+#include "hmz_output/calibration_overlay.hpp"
 
 namespace nelf {
 namespace {
@@ -113,6 +115,43 @@ TEST_F(TextOverlayTest, AnamorphicViewsGetANarrowerBoxInTexels) {
   const int square = overlay.box(Eye::left).width;
   overlay.apply(Eye::left, {texture.id(), 480, 270, 2.0 * 480.0 / 270.0});
   EXPECT_NEAR(overlay.box(Eye::left).width, square / 2.0, 1.0);
+}
+
+// The player's CPU path draws the message into the views' bytes (cover() through draw_over): what
+// apply() draws into the texture, to a code value, with square and with anamorphic texels (where
+// the label is resampled).
+TEST_F(TextOverlayTest, TheCoverDrawnOverTheViewsBytesIsWhatApplyDraws) {
+  const int w = 480, h = 270;
+  const gl::Texture texture = upload_texture(test::photo_chart(w, h), GL_RGBA8);
+  const auto bytes_of = [&](GLuint id) {
+    std::vector<std::uint8_t> out(static_cast<std::size_t>(w) * h * 4);
+    glGetTextureImage(id, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.size()), out.data());
+    return out;
+  };
+  const std::vector<std::uint8_t> view = bytes_of(texture.id());
+  TextOverlay overlay;
+  overlay.set_text("IPD 63.5 mm");
+  for (const double aspect : {0.0, 2.0 * w / h}) {
+    SCOPED_TRACE("display aspect " + std::to_string(aspect));
+    const std::vector<std::uint8_t> gl = bytes_of(overlay.apply(Eye::left, {texture.id(), w, h, aspect}).texture);
+    const Image cover = overlay.cover(w, h, aspect);
+    ASSERT_EQ(cover.width(), w);
+    ASSERT_EQ(cover.height(), h);
+    std::vector<std::uint8_t> cpu = view;
+    draw_over(cpu, cover, 8);
+    int worst = 0, differ = 0, changed = 0;
+    for (std::size_t i = 0; i < cpu.size(); ++i) {
+      worst = std::max(worst, std::abs(cpu[i] - gl[i]));
+      differ += cpu[i] != gl[i];
+      changed += cpu[i] != view[i];
+    }
+    EXPECT_LE(worst, 2);
+    EXPECT_LT(differ, static_cast<int>(cpu.size() / 100));
+    const TextOverlay::Box box = overlay.box(Eye::left);
+    EXPECT_GT(changed, box.width * box.height * 3 * 9 / 10);  // the box is there, all of it
+  }
+  overlay.set_text("");
+  EXPECT_TRUE(overlay.cover(w, h, 0.0).empty());
 }
 
 TEST_F(TextOverlayTest, AViewFormatItCannotCopyIsConvertedWhole) {

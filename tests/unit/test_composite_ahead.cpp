@@ -7,6 +7,7 @@
 
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -37,7 +38,7 @@ std::shared_ptr<const CompositeSetup> make_setup(bool swap_eyes,
   (*tables)[0] = identity_table();
   (*tables)[1] = identity_table();
   return std::make_shared<const CompositeSetup>(CompositeSetup{
-      tables, {std::pair{0, 0}, std::pair{2, 0}}, {3, 1}, swap_eyes, std::move(grid), 1, 1, {1, 1}, 0.0});
+      tables, {std::pair{0, 0}, std::pair{2, 0}}, {3, 1}, swap_eyes, std::move(grid), 1, 1, {1, 1}, 0.0, nullptr});
 }
 
 using Pixel = std::array<int, 4>;
@@ -164,6 +165,29 @@ TEST(CompositeAhead, DrawsTheCalibrationGridOverEachViewBeforeTheEyesAreSwapped)
   ASSERT_TRUE(packed);
   expect_near(pixels_of(*packed)[0], blue);
   expect_near(pixels_of(*packed)[2], Pixel{255, 255, 0, 255});
+  EXPECT_EQ(frames[0]->left[0], 200);  // the queued frame itself is not drawn on
+}
+
+TEST(CompositeAhead, DrawsTheMessageOverBothViewsAfterTheGrid) {
+  CompositeAhead ahead(2);
+  auto grid = std::make_shared<std::array<Image, 2>>(std::array<Image, 2>{Image(1, 1), Image(1, 1)});
+  (*grid)[0].at(0, 0) = Rgba{1.f, 1.f, 0.f, 1.f};  // over the first view: yellow
+  (*grid)[1].at(0, 0) = Rgba{0.f, 0.f, 0.f, 0.f};  // over the second: nothing
+  // A message box half covering: grey at half opacity, over the grid, on both views.
+  auto message = std::make_shared<Image>(1, 1);
+  message->at(0, 0) = Rgba{0.2f, 0.2f, 0.2f, 0.5f};
+  const auto base = make_setup(false, grid);
+  auto with_message = std::make_shared<CompositeSetup>(*base);
+  with_message->message = message;
+  const std::shared_ptr<const CompositeSetup> setup = with_message;
+  const std::vector frames{make_frame(0.0, red, blue)};
+  ahead.want(setup, frames);
+  EXPECT_EQ(ahead.wait_until_idle(5s), 1u);
+  const auto packed = ahead.take(*frames[0], *setup);
+  ASSERT_TRUE(packed);
+  const auto over = [](int view, int text) { return static_cast<int>(std::lround(view * 0.5 + text * 0.5)); };
+  expect_near(pixels_of(*packed)[0], Pixel{over(255, 51), over(255, 51), over(0, 51), 255});  // grid, then text
+  expect_near(pixels_of(*packed)[2], Pixel{over(20, 51), over(60, 51), over(190, 51), 255});
   EXPECT_EQ(frames[0]->left[0], 200);  // the queued frame itself is not drawn on
 }
 

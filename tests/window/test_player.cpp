@@ -285,11 +285,11 @@ class ScopedEnv {
 TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessagesStillShow) {
   // On software GL the player composites 8-bit block means on the CPU from composite tables and
   // uploads the packed frame; NELF_COMPOSITE picks either path. The same clip played both ways,
-  // with 's' and 'c' pressed at 1 s: their message (2 s) is drawn with GL onto the view textures,
-  // so the table run hands those frames to GL, and then the table again, eyes swapped and the
-  // calibration grid drawn into the views' bytes. Every frame both runs rendered (by pts: a loaded
-  // machine may drop different ones) looks the same, text and grid included. Outside the message
-  // the table run's frames are mostly composited ahead, on a worker (hmz_output/composite_ahead).
+  // with 's' and 'c' pressed at 1 s: their message (2 s) is drawn with GL onto the view textures
+  // in the GL run and into the views' bytes in the table run (TextOverlay::cover), eyes swapped
+  // and the calibration grid drawn into the views' bytes too. Every frame both runs rendered (by
+  // pts: a loaded machine may drop different ones) looks the same, text and grid included. The
+  // table run's frames are mostly composited ahead, on a worker (hmz_output/composite_ahead).
   const auto clip = make_clip(dir_, 4);
   PlayerOptions options = silent_options();
   const auto wanted = stereo_prefilter_block(options.profile, options.compositor, 320, 180, 0.0);
