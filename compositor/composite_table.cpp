@@ -502,16 +502,6 @@ void border_pixel(const CompositeTable::BorderPixel& b, const std::uint8_t* imag
 #endif
 }
 
-}  // namespace
-
-// The prefilter's box pass in fixed point: weights in 1/32768 (fixed_weights: each within a
-// 32768th of its float, a sample's sum its float sum rounded), 8-bit cells times 16-bit weights
-// summed exactly in 32 bits (_mm_madd_epi16), each pass rounded to whole codes (half up), as GL's
-// RGBA8 intermediate and target hold them. It was float: the only difference is the weights'
-// rounding, which moves a code by one where the exact sum is within ~0.01 of a half (~0.02 % of
-// the eye's values on test charts; against GL the mean difference stays 0.043 codes).
-namespace {
-
 // A row of `pixels` block means into `out`: as they are, or with red and blue exchanged (every pass
 // after the first copy is the same for each colour channel, so the eye comes out in that order).
 void copy_means_row(const std::uint8_t* in, std::uint8_t* out, std::size_t pixels, ChannelOrder order) {
@@ -541,6 +531,12 @@ void copy_means_row(const std::uint8_t* in, std::uint8_t* out, std::size_t pixel
 
 }  // namespace
 
+// The prefilter's box pass in fixed point: weights in 1/32768 (fixed_weights: each within a
+// 32768th of its float, a sample's sum its float sum rounded), 8-bit cells times 16-bit weights
+// summed exactly in 32 bits (_mm_madd_epi16), each pass rounded to whole codes (half up), as GL's
+// RGBA8 intermediate and target hold them. It was float: the only difference is the weights'
+// rounding, which moves a code by one where the exact sum is within ~0.01 of a half (~0.02 % of
+// the eye's values on test charts; against GL the mean difference stays 0.043 codes).
 void CompositeTable::box_pass(const std::uint8_t* reduced, std::size_t reduced_stride, ChannelOrder order) {
   const std::array<int, 2> size = built_.reduced, prefiltered = built_.prefiltered;
   // Along x: a row of block means at a time (copied into input_, whose spare cells the padded pairs

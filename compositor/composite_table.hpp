@@ -127,10 +127,10 @@ class CompositeTable {
 void fill_opaque_black(std::span<std::uint8_t> rgba);
 
 // Both eyes of a stereo frame into a packed frame (8 bits a channel in `order`, row 0 the top row,
-// `stride` bytes a row),
-// the two in parallel (each table has its own scratch buffers, so the frame is ready sooner): eye e,
-// when it has a table and an origin, renders views[e] (block means, `view_stride` bytes a row) with
-// its panel's top-left corner at origins[e] (x, y). Pixels outside the panels are left as they are.
+// `stride` bytes a row), the two in parallel (each table has its own scratch buffers, so the frame
+// is ready sooner): eye e, when it has a table and an origin, renders views[e] (block means,
+// `view_stride` bytes a row) with its panel's top-left corner at origins[e] (x, y). Pixels outside
+// the panels are left as they are.
 void render_packed_eyes(std::array<std::optional<CompositeTable>, 2>& tables,
                         const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride,
                         const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::uint8_t* packed,

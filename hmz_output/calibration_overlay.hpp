@@ -17,8 +17,9 @@ namespace nelf {
 // the lines look as they do without the reduction (at 1×1: the grid as is, alpha 0 or 1).
 Image cover_grid(const Image& pattern, std::array<int, 2> block);
 
-// `cover` drawn over view bytes (RGBA, `bits` 8 or 16 a channel): where its alpha is 1 the grid
-// replaces the view, where 0 the view shows through.
+// `cover` (the grid, or an on-screen message: TextOverlay::cover) drawn over view bytes (RGBA,
+// `bits` 8 or 16 a channel): where its alpha is 1 it replaces the view, where 0 the view shows
+// through.
 void draw_over(std::vector<std::uint8_t>& pixels, const Image& cover, int bits);
 
 }  // namespace nelf

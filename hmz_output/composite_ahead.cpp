@@ -1,13 +1,11 @@
 #include "hmz_output/composite_ahead.hpp"
 
-#include "hmz_output/calibration_overlay.hpp"
-
-#include <algorithm>
-#include <cmath>
-#include <cstring>
-
 #include <sys/resource.h>
 #include <unistd.h>
+
+#include <algorithm>
+
+#include "hmz_output/calibration_overlay.hpp"
 
 namespace nelf {
 
