@@ -334,6 +334,13 @@ struct VideoSource::Impl {
     const AVCodecParameters& par = *stream->codecpar;
     info.video_codec = avcodec_get_name(par.codec_id);
 
+    // No size at all: neither the container nor a decoded frame told it, e.g. a PNG whose header
+    // claims more than the pixel limit (probing did not decode it).
+    if (par.width == 0 && par.height == 0)
+      fail(
+          fmt::format("cannot tell the frame size: the first frame does not decode (damaged, or more than the "
+                      "limit of {} pixels: --max-pixels raises it)",
+                      options.max_pixels));
     if (par.width <= 0 || par.height <= 0 || par.width > kMaxVideoDimension || par.height > kMaxVideoDimension)
       fail(fmt::format("absurd frame size {}x{} (must be 1 to {} pixels each way)", par.width, par.height,
                        kMaxVideoDimension));
