@@ -215,7 +215,8 @@ void add_common_options(CLI::App& cmd, CommonArgs& args) {
 void add_max_pixels_option(CLI::App& cmd, std::int64_t& max_pixels) {
   cmd.add_option("--max-pixels", max_pixels,
                  "Refuse images and video frames of more pixels than this, before decoding them")
-      ->check(CLI::PositiveNumber)
+      // Up to 16384x16384: no image or frame may be larger than 16384 a side anyway.
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{16384} * 16384))
       ->capture_default_str();
 }
 
