@@ -15,6 +15,7 @@
 #include "compositor/gl_compositor.hpp"
 #include "compositor/text_overlay.hpp"
 #include "hmz_output/packing.hpp"
+#include "inputs/printable.hpp"
 
 namespace nelf::app {
 
@@ -142,7 +143,7 @@ class Session {
         message = settings_.save.empty() ? "nothing saved: start with --save FILE.toml" : save();
       } catch (const UserError& e) {
         message = fmt::format("not saved: {}", e.what());  // e.g. the disk is full; keep going
-        fmt::print(stderr, "nelf: {}\n", message);
+        fmt::print(stderr, "nelf: {}\n", printable(message));
       }
     }
     if (step.help) {

@@ -16,6 +16,7 @@
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
 #include "hmz_output/signal.hpp"
+#include "inputs/printable.hpp"
 #include "inputs/stereo_layout.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/synthetic_source.hpp"
@@ -61,6 +62,7 @@ ConvertPlan plan_convert(const ConvertArgs& args) {
   plan.still.layout = common.layout;
   if (!args.right.empty()) plan.still.right = args.right;
   plan.still.swap_eyes = args.swap_eyes;
+  plan.still.max_pixels = args.max_pixels;
   plan.compositor = common.compositor;
   plan.profile = std::move(common.profile);
   plan.signal = common.signal;
@@ -103,6 +105,7 @@ void run_convert_video(const ConvertArgs& args) {
   r.quiet = args.quiet;
   r.strict = args.strict;
   r.allow_network = args.allow_network;
+  r.max_pixels = args.max_pixels;
   const std::filesystem::path out(args.output);
   const auto dir = out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path();
   std::error_code ec;
@@ -124,7 +127,7 @@ void run_convert(const ConvertArgs& args) {
   } catch (const StillError& e) {
     throw UserError(e.what(), 1);
   }
-  if (!still.decision.warning.empty()) fmt::print(stderr, "nelf: warning: {}\n", still.decision.warning);
+  if (!still.decision.warning.empty()) fmt::print(stderr, "nelf: warning: {}\n", printable(still.decision.warning));
 
   write_packed_still(still.views, plan.profile, plan.signal, plan.compositor, args.output, plan.write);
 }
@@ -206,6 +209,15 @@ void add_common_options(CLI::App& cmd, CommonArgs& args) {
                  "EGL device index to render on (default: NELF_GPU, else the first GPU, else software)");
   cmd.add_flag("--allow-network", args.allow_network,
                "Let FFmpeg use network protocols (default: files and pipes only)");
+  add_max_pixels_option(cmd, args.max_pixels);
+}
+
+void add_max_pixels_option(CLI::App& cmd, std::int64_t& max_pixels) {
+  cmd.add_option("--max-pixels", max_pixels,
+                 "Refuse images and video frames of more pixels than this, before decoding them")
+      // Up to 16384x16384: no image or frame may be larger than 16384 a side anyway.
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{16384} * 16384))
+      ->capture_default_str();
 }
 
 void add_convert_command(CLI::App& app) {

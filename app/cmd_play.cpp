@@ -11,6 +11,7 @@
 #include "app/live_display.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/player.hpp"
+#include "inputs/printable.hpp"
 #include "inputs/stereo_frame_source.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/video_source.hpp"
@@ -48,6 +49,7 @@ void run_play(const PlayArgs& args) {
   request.swap_eyes = args.swap_eyes;
   request.quiet = args.quiet;
   request.allow_network = args.allow_network;
+  request.max_pixels = args.max_pixels;
   const auto source = open_stereo_frame_source(request);
 
   PlayerOptions options;
@@ -61,7 +63,7 @@ void run_play(const PlayArgs& args) {
 
   const auto display = open_live_display({kind, args.monitor, args.connector, fmt::format("nelf: {}", args.input)},
                                          common.profile, common.signal);
-  if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", display->description());
+  if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", printable(display->description()));
 
   InterruptGuard guard;
   const PlayResult result = play(*display, *source, options, &interrupted);

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "app/commands.hpp"
+#include "inputs/printable.hpp"
 #include "inputs/stereo_layout.hpp"
 #include "inputs/video_source.hpp"
 
@@ -22,6 +23,7 @@ struct ProbeOptions {
   bool swap_eyes = false;
   bool json = false;
   bool allow_network = false;
+  std::int64_t max_pixels = kDefaultMaxPixels;
 };
 
 // The H.264/HEVC frame-packing SEI rides on keyframes only, so decode until the first keyframe
@@ -37,7 +39,8 @@ struct ProbeResult {
 
 ProbeResult probe(const ProbeOptions& options) {
   quiet_ffmpeg_logs(true);
-  VideoSource source(options.input, VideoSourceOptions{.allow_network = options.allow_network});
+  VideoSource source(options.input,
+                     VideoSourceOptions{.allow_network = options.allow_network, .max_pixels = options.max_pixels});
   int decoded = 0;
   bool any_frame = false;
   while (decoded < kMaxFramesBeforeKeyframe) {
@@ -127,6 +130,7 @@ void add_probe_command(CLI::App& app) {
   cmd->add_flag("--json", options->json, "Print one JSON object instead of the summary");
   cmd->add_flag("--allow-network", options->allow_network,
                 "Let FFmpeg use network protocols (off: only local files and pipes)");
+  add_max_pixels_option(*cmd, options->max_pixels);
   cmd->callback([options] {
     ProbeResult result;
     try {
@@ -136,10 +140,10 @@ void add_probe_command(CLI::App& app) {
     } catch (const UnsupportedStereoMetadata& e) {
       throw UserError(fmt::format("{}: {}", options->input, e.what()));
     }
-    if (!result.decision.warning.empty()) fmt::print(stderr, "nelf: warning: {}\n", result.decision.warning);
+    if (!result.decision.warning.empty()) fmt::print(stderr, "nelf: warning: {}\n", printable(result.decision.warning));
     if (result.stats.problems() > 0)
       fmt::print(stderr, "nelf: warning: {}: {} decode problem(s) in the first frames (damaged file?)\n",
-                 options->input, result.stats.problems());
+                 printable(options->input), result.stats.problems());
     if (options->json)
       print_json(result);
     else

@@ -20,6 +20,7 @@
 #include "compositor/mapping.hpp"
 #include "compositor/reference.hpp"
 #include "hmz_output/image_sink.hpp"
+#include "inputs/printable.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/synthetic_source.hpp"
 
@@ -50,6 +51,7 @@ struct SimulateArgs {
   std::string layout = "auto";
   std::string right;
   bool swap_eyes = false;
+  std::int64_t max_pixels = kDefaultMaxPixels;
 };
 
 double parse_number(std::string_view text, bool& ok) {
@@ -174,6 +176,7 @@ void run_simulate(const SimulateArgs& args) {
   still.layout = parse_layout_option(args.layout);
   if (!args.right.empty()) still.right = args.right;
   still.swap_eyes = args.swap_eyes;
+  still.max_pixels = args.max_pixels;
   try {
     check_image_writable(args.output, {true, 8});
     if (!args.ideal.empty()) check_image_writable(args.ideal, {true, 8});
@@ -200,7 +203,7 @@ void run_simulate(const SimulateArgs& args) {
     try {
       StillStereo stereo = load_still(args.input, still);
       if (!stereo.decision.warning.empty() && !args.json)
-        fmt::print(stderr, "nelf: warning: {}\n", stereo.decision.warning);
+        fmt::print(stderr, "nelf: warning: {}\n", printable(stereo.decision.warning));
       view = eye == Eye::left ? std::move(stereo.views.left) : std::move(stereo.views.right);
     } catch (const StillError& e) {
       throw UserError(e.what());
@@ -256,6 +259,7 @@ void add_simulate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--right", args->right, "The right view as a separate image (layout pair)");
   cmd->add_flag("--swap-eyes", args->swap_eyes, "The source stores the right view first");
+  add_max_pixels_option(*cmd, args->max_pixels);
   cmd->add_option("--profile", args->profile, "Device profile: built-in name or TOML file")->capture_default_str();
   cmd->add_option("--eye", args->eye, "Which eye")->check(CLI::IsMember({"left", "right"}))->capture_default_str();
   cmd->add_option("--focus-mm", args->focus,

@@ -10,6 +10,7 @@
 #include "compositor/profile.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/signal.hpp"
+#include "inputs/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
 #include "inputs/user_error.hpp"
 
@@ -33,6 +34,7 @@ struct CommonArgs {
   int fsaa = 1;
   std::optional<int> gpu;
   bool allow_network = false;
+  std::int64_t max_pixels = kDefaultMaxPixels;
 };
 
 // CommonArgs checked before any input is read: layout, antialiasing, device, profile and signal.
@@ -45,6 +47,8 @@ struct CommonOptions {
 
 // Registers INPUT (positional) and the CommonArgs options on `cmd`.
 void add_common_options(CLI::App& cmd, CommonArgs& args);
+// Registers --max-pixels (shared by convert, play, probe and simulate: one wording).
+void add_max_pixels_option(CLI::App& cmd, std::int64_t& max_pixels);
 // Throws UserError (status 2) for contradictory options and unknown signals, ProfileError for bad
 // profiles. `still`: the input is a still image (refuses layout alt).
 CommonOptions parse_common_options(const CommonArgs& args, bool still);

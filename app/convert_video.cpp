@@ -1,4 +1,5 @@
 #include "app/convert_video.hpp"
+#include "inputs/printable.hpp"
 
 #include <fmt/format.h>
 #include <fmt/printf.h>
@@ -393,7 +394,8 @@ void convert_video(const VideoConvertRequest& r) {
       StereoSourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network,
                           [&r](int width, int height, double aspect) {
                             return stereo_prefilter_block(r.profile, r.compositor, width, height, aspect);
-                          }});
+                          },
+                          r.max_pixels});
 
   // The first frame fixes the view size and depth for the whole run.
   auto first = source->next();
@@ -491,7 +493,7 @@ void convert_video(const VideoConvertRequest& r) {
     if (const std::int64_t lost = source->lost_frames(); lost > 0) {
       const std::string what = fmt::format("{}: damaged or truncated: {} frame(s) lost or damaged", r.input, lost);
       if (r.strict) throw UserError(what + " (--strict)", 1);
-      fmt::print(stderr, "nelf: warning: {}; converted what decodes\n", what);
+      fmt::print(stderr, "nelf: warning: {}; converted what decodes\n", printable(what));
     }
     sink->finish();
     progress.finish(fmt::format("wrote {}", r.output));

@@ -7,6 +7,7 @@
 #include "compositor/profile.hpp"
 #include "hmz_output/signal.hpp"
 #include "hmz_output/video_encoder.hpp"
+#include "inputs/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
 
 namespace nelf::app {
@@ -26,6 +27,7 @@ struct VideoConvertRequest {
   bool quiet = false;
   bool strict = false;
   bool allow_network = false;
+  std::int64_t max_pixels = kDefaultMaxPixels;
 };
 
 // True when `output` names an image sequence (a printf pattern like %05d).

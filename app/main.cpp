@@ -6,6 +6,7 @@
 
 #include "app/commands.hpp"
 #include "compositor/profile.hpp"
+#include "inputs/printable.hpp"
 
 namespace {
 
@@ -36,17 +37,19 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    // One line, the way a user can act on it, and the conventional usage-error status.
-    fmt::print(stderr, "nelf: {} (see nelf --help)\n", e.what());
+    // One line, the way a user can act on it, and the conventional usage-error status. Every
+    // message is printed through printable(): file names, profile keys and values and metadata
+    // in it come from outside and may hold newlines or terminal escape sequences.
+    fmt::print(stderr, "nelf: {} (see nelf --help)\n", nelf::printable(e.what()));
     return 2;
   } catch (const nelf::ProfileError& e) {
-    fmt::print(stderr, "nelf: {}\n", e.what());
+    fmt::print(stderr, "nelf: {}\n", nelf::printable(e.what()));
     return 2;
   } catch (const nelf::app::UserError& e) {
-    fmt::print(stderr, "nelf: {}\n", e.what());
+    fmt::print(stderr, "nelf: {}\n", nelf::printable(e.what()));
     return e.status();
   } catch (const std::exception& e) {
-    fmt::print(stderr, "nelf: error: {}\n", e.what());
+    fmt::print(stderr, "nelf: error: {}\n", nelf::printable(e.what()));
     return 1;
   }
   return 0;

@@ -91,13 +91,13 @@ auto guarded(Call call) {
 
 void preload() { api(); }
 
-Pixels read_file(const std::string& path, const std::string& format, int max_dimension) {
-  return guarded([&](const ModuleApi& m) { return m.read_file(path, format, max_dimension); });
+Pixels read_file(const std::string& path, const std::string& format, const DecodeLimits& limits) {
+  return guarded([&](const ModuleApi& m) { return m.read_file(path, format, limits); });
 }
 
 Pixels decode(std::span<const std::byte> encoded, const std::string& format, const std::string& name,
-              int max_dimension) {
-  return guarded([&](const ModuleApi& m) { return m.decode(encoded, format, name, max_dimension); });
+              const DecodeLimits& limits) {
+  return guarded([&](const ModuleApi& m) { return m.decode(encoded, format, name, limits); });
 }
 
 bool has_writer(const std::string& format_or_file_name) {

@@ -10,6 +10,7 @@
 // Every function throws ImageLibraryError, one line, on failure, including when the module cannot
 // be loaded (the message names the file and why).
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -35,12 +36,18 @@ struct Pixels {
 
 // Reads the first subimage of a file as float. `format` ("jpeg") overrides the format OpenImageIO
 // would choose from the name; "" leaves it to OpenImageIO. The header is checked before any pixel
-// is allocated: no pixels, more than `max_dimension` a side or a volume image is an error. At most
-// four channels are read. Messages start with `path`.
-Pixels read_file(const std::string& path, const std::string& format, int max_dimension);
+// is decoded or allocated: no pixels, more than `limits.max_dimension` a side, more than
+// `limits.max_pixels` in all (inputs/pixel_limit.hpp) or a volume image is an error. At most four
+// channels are read, so memory is bounded by the pixel count. Messages start with `path`, and
+// OpenImageIO's (libpng's, libjpeg's) own complaint is folded into them: nothing else is printed.
+struct DecodeLimits {
+  int max_dimension = 0;
+  std::int64_t max_pixels = 0;
+};
+Pixels read_file(const std::string& path, const std::string& format, const DecodeLimits& limits);
 // The same for an image held in memory, in the given format; messages start with `name`.
 Pixels decode(std::span<const std::byte> encoded, const std::string& format, const std::string& name,
-              int max_dimension);
+              const DecodeLimits& limits);
 
 // Whether OpenImageIO has a writer for this format name or file name.
 bool has_writer(const std::string& format_or_file_name);

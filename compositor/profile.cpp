@@ -103,16 +103,29 @@ class Reader {
     throw ProfileError(fmt::format("{}: {} {}", where, key, message));
   }
 
+  // The value as a message shows it: on one line (toml++ prints long arrays over several lines),
+  // long arrays cut short. Control characters in strings are escaped where messages are printed.
   static std::string show(const toml::node& node) {
     std::ostringstream out;
-    if (auto s = node.as_string())
+    if (auto s = node.as_string()) {
       out << '"' << s->get() << '"';
-    else if (auto a = node.as_array())
-      out << *a;
-    else if (node.is_table())
+    } else if (auto a = node.as_array()) {
+      constexpr std::size_t kShown = 8;
+      out << '[';
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        if (i > 0) out << ", ";
+        if (i == kShown) {
+          out << "... (" << a->size() << " values)";
+          break;
+        }
+        out << show(*a->get(i));
+      }
+      out << ']';
+    } else if (node.is_table()) {
       out << "a table";
-    else
+    } else {
       node.visit([&](const auto& v) { out << v; });
+    }
     return out.str();
   }
 

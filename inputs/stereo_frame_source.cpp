@@ -1,4 +1,5 @@
 #include "inputs/stereo_frame_source.hpp"
+#include "inputs/printable.hpp"
 
 #include <fmt/format.h>
 
@@ -77,7 +78,7 @@ class SyntheticFrameSource final : public StereoFrameSource {
 
 class FileFrameSource final : public StereoFrameSource {
  public:
-  FileFrameSource(const StereoSourceRequest& r) : path_(r.input), source_(open(r.input, r.allow_network)) {
+  FileFrameSource(const StereoSourceRequest& r) : path_(r.input), source_(open(r.input, r)) {
     if (r.start_s) source_.seek(*r.start_s);
     pending_ = source_.next_frame();
     if (!pending_ && r.start_s && source_.info().duration_s && *r.start_s >= *source_.info().duration_s)
@@ -102,10 +103,10 @@ class FileFrameSource final : public StereoFrameSource {
     } catch (const std::exception& e) {
       throw UserError(fmt::format("{}: {}", r.input, e.what()), 1);
     }
-    if (!decision_.warning.empty() && !r.quiet) fmt::print(stderr, "nelf: warning: {}\n", decision_.warning);
+    if (!decision_.warning.empty() && !r.quiet) fmt::print(stderr, "nelf: warning: {}\n", printable(decision_.warning));
     if (decision_.layout == StereoLayout::pair) {
       if (r.right.empty()) throw UserError("layout pair needs the right view as a second file (--right FILE)", 2);
-      right_.emplace(open(r.right, r.allow_network));
+      right_.emplace(open(r.right, r));
       if (r.start_s) right_->seek(*r.start_s);
       const VideoInfo &a = source_.info(), &b = right_->info();
       if (a.width != b.width || a.height != b.height)
@@ -122,9 +123,9 @@ class FileFrameSource final : public StereoFrameSource {
     }
     if (r.view_block) reduce_views(r.view_block);
     if (!r.quiet)
-      fmt::print(stderr, "nelf: {}: {}x{} {}, layout {}{} ({})\n", r.input, source_.info().width, source_.info().height,
-                 source_.info().video_codec, to_string(decision_.layout), decision_.swap_eyes ? " swapped" : "",
-                 to_string(decision_.rule));
+      fmt::print(stderr, "nelf: {}: {}x{} {}, layout {}{} ({})\n", printable(r.input), source_.info().width,
+                 source_.info().height, source_.info().video_codec, to_string(decision_.layout),
+                 decision_.swap_eyes ? " swapped" : "", to_string(decision_.rule));
   }
 
   std::optional<StereoVideoFrame> next() override {
@@ -239,9 +240,9 @@ class FileFrameSource final : public StereoFrameSource {
   }
 
  private:
-  static VideoSource open(const std::string& path, bool allow_network) {
+  static VideoSource open(const std::string& path, const StereoSourceRequest& r) {
     try {
-      return VideoSource(path, VideoSourceOptions{allow_network, true});
+      return VideoSource(path, VideoSourceOptions{r.allow_network, true, r.max_pixels});
     } catch (const VideoError& e) {
       throw UserError(e.what(), 1);
     }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "inputs/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
 
 namespace nelf {
@@ -40,10 +41,11 @@ struct StereoSourceRequest {
   std::string right;                   // second input for layout pair
   std::optional<StereoLayout> layout;  // nullopt: detect
   bool swap_eyes = false;
-  std::optional<double> start_s;  // start here (seconds from the start of the input)
-  bool quiet = false;             // no line describing the input, no layout warning
-  bool allow_network = false;     // FFmpeg protocols beyond file and pipe
-  ViewBlockChooser view_block;    // empty: whole views; else as reduce_views() from the first frame
+  std::optional<double> start_s;                // start here (seconds from the start of the input)
+  bool quiet = false;                           // no line describing the input, no layout warning
+  bool allow_network = false;                   // FFmpeg protocols beyond file and pipe
+  ViewBlockChooser view_block;                  // empty: whole views; else as reduce_views() from the first frame
+  std::int64_t max_pixels = kDefaultMaxPixels;  // --max-pixels: larger frames are refused undecoded
 };
 
 class StereoFrameSource {

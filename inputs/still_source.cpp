@@ -1,13 +1,10 @@
 #include "inputs/still_source.hpp"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <memory>
@@ -52,37 +49,6 @@ Image to_rgba(const image_library::Pixels& pixels) {
   return image;
 }
 
-// OIIO 2.4's PNG reader leaves libpng's default error handler in place, which prints
-// "libpng error: ..." on stderr before OIIO turns the failure into an error we report ourselves.
-// While a PNG is decoded, fd 2 points at /dev/null so that the user sees our one line only. Only
-// PNGs, and only for the call's duration: nothing else prints meanwhile in the still path.
-class SilencedStderr {
- public:
-  SilencedStderr() {
-    std::fflush(stderr);
-    saved_ = ::dup(STDERR_FILENO);
-    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
-    if (saved_ >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
-    if (null >= 0) ::close(null);
-  }
-  ~SilencedStderr() {
-    if (saved_ < 0) return;
-    ::dup2(saved_, STDERR_FILENO);
-    ::close(saved_);
-  }
-  SilencedStderr(const SilencedStderr&) = delete;
-  SilencedStderr& operator=(const SilencedStderr&) = delete;
-
- private:
-  int saved_ = -1;
-};
-
-bool has_png_signature(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  char magic[8] = {};
-  return file.read(magic, sizeof magic) && std::memcmp(magic, "\x89PNG\r\n\x1a\n", 8) == 0;
-}
-
 std::vector<std::byte> read_bytes(const fs::path& path) {
   constexpr std::uintmax_t kMaxBytes = std::uintmax_t{1} << 30;  // 1 GiB: far beyond any real MPO
   std::error_code ec;
@@ -111,8 +77,8 @@ View natural_view(Image image) {
 }
 
 StillStereo load_pair(const fs::path& left_path, const fs::path& right_path, const StillOptions& options) {
-  Image left = read_image_file(left_path);
-  Image right = read_image_file(right_path);
+  Image left = read_image_file(left_path, options.max_pixels);
+  Image right = read_image_file(right_path, options.max_pixels);
   if (left.width() != right.width() || left.height() != right.height())
     throw StillError(fmt::format("{} is {} but {} is {}: the two views of a pair must have the same size",
                                  left_path.string(), size_of(left), right_path.string(), size_of(right)));
@@ -135,9 +101,11 @@ StillStereo load_mpo(const fs::path& path, const StillOptions& options) {
     throw StillError(
         fmt::format("{}: the MPO file holds {} image(s), a stereo pair needs two", path.string(), starts.size()));
   const std::span<const std::byte> all(bytes);
-  Image left = decode_image(all.subspan(starts[0], starts[1] - starts[0]), "jpeg", path.string() + " (left image)");
+  Image left = decode_image(all.subspan(starts[0], starts[1] - starts[0]), "jpeg", path.string() + " (left image)",
+                            options.max_pixels);
   const std::size_t right_end = starts.size() > 2 ? starts[2] : bytes.size();
-  Image right = decode_image(all.subspan(starts[1], right_end - starts[1]), "jpeg", path.string() + " (right image)");
+  Image right = decode_image(all.subspan(starts[1], right_end - starts[1]), "jpeg", path.string() + " (right image)",
+                             options.max_pixels);
   if (left.width() != right.width() || left.height() != right.height())
     throw StillError(fmt::format("{}: its left image is {} but its right image is {}", path.string(), size_of(left),
                                  size_of(right)));
@@ -272,22 +240,21 @@ std::vector<std::size_t> find_mpo_images(std::span<const std::byte> bytes) {
   return starts;
 }
 
-Image decode_image(std::span<const std::byte> encoded, const std::string& format, const std::string& name) {
+Image decode_image(std::span<const std::byte> encoded, const std::string& format, const std::string& name,
+                   std::int64_t max_pixels) {
   try {
-    return to_rgba(image_library::decode(encoded, format, name, kMaxImageDimension));
+    return to_rgba(image_library::decode(encoded, format, name, {kMaxImageDimension, max_pixels}));
   } catch (const image_library::ImageLibraryError& e) {
     throw StillError(e.what());
   }
 }
 
-Image read_image_file(const fs::path& path) {
+Image read_image_file(const fs::path& path, std::int64_t max_pixels) {
   require_file(path);
-  std::optional<SilencedStderr> silence_libpng;
-  if (has_png_signature(path)) silence_libpng.emplace();
   // OIIO does not know the .jps extension; a JPS file is a JPEG.
   const std::string format = lowercase_extension(path) == ".jps" ? "jpeg" : "";
   try {
-    return to_rgba(image_library::read_file(path.string(), format, kMaxImageDimension));
+    return to_rgba(image_library::read_file(path.string(), format, {kMaxImageDimension, max_pixels}));
   } catch (const image_library::ImageLibraryError& e) {
     throw StillError(e.what());
   }
@@ -308,7 +275,7 @@ StillStereo load_still(const fs::path& path, const StillOptions& options) {
     return load_mpo(path, options);
   }
 
-  Image frame = read_image_file(path);
+  Image frame = read_image_file(path, options.max_pixels);
   StillStereo result;
   result.decision =
       detect_stereo_layout({options.layout, std::nullopt, frame.width(), frame.height(), path, options.swap_eyes});

@@ -3,6 +3,7 @@
 // into a stereo pair. Handles one-file layouts (side-by-side, top-bottom, frame-packed, mono), a pair
 // of files (--right), JPS (right-left side-by-side JPEG) and MPO (two JPEGs in one file, left first).
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <span>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "compositor/image.hpp"
+#include "inputs/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
 
 namespace nelf {
@@ -26,12 +28,14 @@ constexpr int kMaxImageDimension = 16384;
 
 // Reads the first image of a file as float RGBA 0..1 (gray -> r=g=b, missing alpha -> 1; 8-, 16-bit
 // and float sources). `.jps` files are read as JPEG. Throws StillError for missing, unreadable,
-// corrupt or truncated files and for zero or over-large dimensions.
-Image read_image_file(const std::filesystem::path& path);
+// corrupt or truncated files and for zero or over-large dimensions, or more than `max_pixels`
+// pixels (checked from the header, before decoding: inputs/pixel_limit.hpp).
+Image read_image_file(const std::filesystem::path& path, std::int64_t max_pixels = kDefaultMaxPixels);
 
 // The same for an encoded image held in memory (e.g. the second JPEG of an MPO). `format` is an
 // OIIO format name ("jpeg"); `name` is used in error messages.
-Image decode_image(std::span<const std::byte> encoded, const std::string& format, const std::string& name);
+Image decode_image(std::span<const std::byte> encoded, const std::string& format, const std::string& name,
+                   std::int64_t max_pixels = kDefaultMaxPixels);
 
 // Byte offsets of the JPEG images stored back to back in `bytes` (an MPO file holds two or more;
 // a plain JPEG one). Walks the JPEG segments of each image to its EOI, then looks for the next SOI.
@@ -42,9 +46,10 @@ std::vector<std::size_t> find_jpeg_images(std::span<const std::byte> bytes);
 std::vector<std::size_t> find_mpo_images(std::span<const std::byte> bytes);
 
 struct StillOptions {
-  std::optional<StereoLayout> layout;          // --layout; nothing = detect
-  std::optional<std::filesystem::path> right;  // --right: the right view is a second file
-  bool swap_eyes = false;                      // --swap-eyes
+  std::optional<StereoLayout> layout;           // --layout; nothing = detect
+  std::optional<std::filesystem::path> right;   // --right: the right view is a second file
+  bool swap_eyes = false;                       // --swap-eyes
+  std::int64_t max_pixels = kDefaultMaxPixels;  // --max-pixels: the largest image read (each view file)
 };
 
 struct StillStereo {

@@ -239,6 +239,12 @@ struct VideoSource::Impl {
 
   [[noreturn]] void fail(const std::string& what) const { throw VideoError(fmt::format("{}: {}", info.path, what)); }
 
+  // Refuses frames over --max-pixels (inputs/pixel_limit.hpp); `where` says which (" in the stream").
+  void check_pixel_limit(int width, int height, std::string_view where) const {
+    if (const auto problem = pixel_limit_problem(width, height, options.max_pixels))
+      fail(fmt::format("video frames{}: {}", where, *problem));
+  }
+
   void open(const std::string& path) {
     info.path = path;
     std::string url = path;
@@ -269,8 +275,21 @@ struct VideoSource::Impl {
     // FFmpeg opens any text file as "tty" (ANSI art) video; a text file is never meant as content.
     if (info.container == "tty") fail("not a media file (it looks like text)");
 
-    if (const int found = avformat_find_stream_info(format.get(), nullptr); found < 0)
-      fail(fmt::format("not a readable media file: {}", error_string(found)));
+    // Frame sizes the container's header declares (Matroska, MP4, Y4M) are checked before probing,
+    // which decodes the first frames. The decoders probing opens get the pixel limit too, so that
+    // a stream whose size only its frames tell (a PNG, MPEG-TS) is not decoded over it either.
+    for (unsigned i = 0; i < format->nb_streams; ++i) {
+      const AVStream* declared = format->streams[i];
+      if (declared->codecpar->codec_type == AVMEDIA_TYPE_VIDEO &&
+          (declared->disposition & AV_DISPOSITION_ATTACHED_PIC) == 0)
+        check_pixel_limit(declared->codecpar->width, declared->codecpar->height, "");
+    }
+    const std::string max_pixels = std::to_string(options.max_pixels);
+    std::vector<AVDictionary*> probe_options(format->nb_streams, nullptr);
+    for (AVDictionary*& o : probe_options) av_dict_set(&o, "max_pixels", max_pixels.c_str(), 0);
+    const int found = avformat_find_stream_info(format.get(), probe_options.empty() ? nullptr : probe_options.data());
+    for (AVDictionary*& o : probe_options) av_dict_free(&o);
+    if (found < 0) fail(fmt::format("not a readable media file: {}", error_string(found)));
 
     for (unsigned i = 0; i < format->nb_streams; ++i)
       if (format->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_AUDIO) ++info.audio_streams;
@@ -315,9 +334,17 @@ struct VideoSource::Impl {
     const AVCodecParameters& par = *stream->codecpar;
     info.video_codec = avcodec_get_name(par.codec_id);
 
+    // No size at all: neither the container nor a decoded frame told it, e.g. a PNG whose header
+    // claims more than the pixel limit (probing did not decode it).
+    if (par.width == 0 && par.height == 0)
+      fail(
+          fmt::format("cannot tell the frame size: the first frame does not decode (damaged, or more than the "
+                      "limit of {} pixels: --max-pixels raises it)",
+                      options.max_pixels));
     if (par.width <= 0 || par.height <= 0 || par.width > kMaxVideoDimension || par.height > kMaxVideoDimension)
       fail(fmt::format("absurd frame size {}x{} (must be 1 to {} pixels each way)", par.width, par.height,
                        kMaxVideoDimension));
+    check_pixel_limit(par.width, par.height, "");
     info.coded_width = par.width;
     info.coded_height = par.height;
     const AVRational sar = av_guess_sample_aspect_ratio(format.get(), stream, nullptr);
@@ -359,7 +386,8 @@ struct VideoSource::Impl {
     if (const int copied = avcodec_parameters_to_context(codec.get(), &par); copied < 0)
       fail(fmt::format("cannot set up the {} decoder: {}", info.video_codec, error_string(copied)));
     codec->pkt_timebase = stream->time_base;
-    codec->thread_count = 0;  // one per core
+    codec->max_pixels = options.max_pixels;  // a larger frame later in the stream is not decoded either
+    codec->thread_count = 0;                 // one per core
     codec->thread_type = FF_THREAD_FRAME | FF_THREAD_SLICE;
     if (const int codec_opened = avcodec_open2(codec.get(), decoder, nullptr); codec_opened < 0)
       fail(fmt::format("cannot open the {} decoder: {}", info.video_codec, error_string(codec_opened)));
@@ -528,6 +556,7 @@ struct VideoSource::Impl {
     if (decoded.width <= 0 || decoded.height <= 0 || decoded.width > kMaxVideoDimension ||
         decoded.height > kMaxVideoDimension)
       fail(fmt::format("absurd frame size {}x{} in the stream", decoded.width, decoded.height));
+    check_pixel_limit(decoded.width, decoded.height, " later in the stream");
     VideoFrame out;
     if (!regions.empty()) {
       convert_regions(decoded, out);
@@ -622,6 +651,12 @@ struct VideoSource::Impl {
         continue;
       }
       if (packet->stream_index == info.stream_index) {
+        // The demuxer's parser reads each packet's header (H.264/HEVC/MPEG-2 sequence headers):
+        // a stream that switches to frames over the limit is refused here, with their size,
+        // rather than by the decoder (which would only count errors).
+        if (const AVCodecParserContext* parser = av_stream_get_parser(stream);
+            parser != nullptr && parser->width > 0 && parser->height > 0)
+          check_pixel_limit(parser->width, parser->height, " later in the stream");
         if ((packet->flags & AV_PKT_FLAG_CORRUPT) != 0) ++stats.decode_errors;
         const int sent = avcodec_send_packet(codec.get(), packet.get());
         if (sent < 0 && sent != AVERROR(EAGAIN)) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "compositor/image.hpp"
+#include "inputs/pixel_limit.hpp"
 #include "inputs/stereo_metadata.hpp"
 
 namespace nelf {
@@ -93,6 +94,8 @@ struct VideoFrame {
 struct VideoSourceOptions {
   bool allow_network = false;  // false: FFmpeg may only use the file and pipe protocols
   bool apply_rotation = true;  // false: deliver frames as stored and leave rotation to the caller
+  // --max-pixels: a stream, or a frame of it, larger than this is refused before it is decoded.
+  std::int64_t max_pixels = kDefaultMaxPixels;
 };
 
 // What went wrong while decoding, so that the caller can warn (or refuse, with --strict).

@@ -13,7 +13,7 @@ packages=(
   xdotool
   # media: FFmpeg libraries, the ffmpeg CLI for test media and benchmarks, OpenImageIO
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libswresample-dev libavfilter-dev
-  ffmpeg libopenimageio-dev
+  ffmpeg libopenimageio-dev libpng-dev
   # maths, configuration, CLI, formatting, JSON, audio
   libglm-dev libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libsdl2-dev
   # tests

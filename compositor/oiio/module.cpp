@@ -5,13 +5,20 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <png.h>
 
 #include <algorithm>
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "compositor/oiio/module_api.hpp"
+#include "inputs/pixel_limit.hpp"
 
 namespace nelf::image_library {
 namespace {
@@ -26,16 +33,119 @@ std::string first_line(std::string message) {
 
 [[noreturn]] void fail(const std::string& message) { throw std::runtime_error(message); }
 
+// Refuses a size the header claims before anything is decoded: no pixels, too wide or tall, too many
+// pixels (a decompression bomb: a few hundred KB of PNG can claim 16384x16384).
+void check_size(const std::string& name, std::int64_t width, std::int64_t height, int channels,
+                const DecodeLimits& limits) {
+  if (width <= 0 || height <= 0 || channels <= 0)
+    fail(name + ": the image has no pixels (" + std::to_string(width) + "x" + std::to_string(height) + ", " +
+         std::to_string(channels) + " channels)");
+  if (width > limits.max_dimension || height > limits.max_dimension)
+    fail(name + ": " + std::to_string(width) + "x" + std::to_string(height) + " is too large (at most " +
+         std::to_string(limits.max_dimension) + " pixels per side)");
+  // At most four channels are read (read_opened), so the pixel count bounds the memory.
+  if (const auto problem = pixel_limit_problem(width, height, limits.max_pixels)) fail(name + ": " + *problem);
+}
+
+// OIIO 2.4's PNG reader installs an error handler that records libpng's message and returns, so
+// libpng falls back to its default handler, which prints "libpng error: ..." on stderr before OIIO
+// reports the failure. A PNG is therefore first decoded here, row by row into one scratch row, by
+// libpng with handlers that keep the message and never print: a damaged file fails with one line
+// (ours) and never reaches OIIO. This pass also checks the header's size before OIIO sees it.
+struct PngCheck {
+  std::jmp_buf jump;
+  char message[256] = "";
+  std::span<const std::byte> bytes;
+  std::size_t at = 0;
+};
+
+extern "C" void png_check_error(png_structp png, png_const_charp message) {
+  auto* check = static_cast<PngCheck*>(png_get_error_ptr(png));
+  std::snprintf(check->message, sizeof check->message, "%s", message ? message : "unknown libpng error");
+  std::longjmp(check->jump, 1);
+}
+extern "C" void png_check_warning(png_structp, png_const_charp) {}  // OIIO ignores them too
+extern "C" void png_check_read(png_structp png, png_bytep out, png_size_t size) {
+  auto* check = static_cast<PngCheck*>(png_get_io_ptr(png));
+  if (size > check->bytes.size() - check->at) png_error(png, "the file ends early (truncated)");
+  std::memcpy(out, check->bytes.data() + check->at, size);
+  check->at += size;
+}
+
+struct PngHeader {
+  png_uint_32 width = 0, height = 0;
+  int channels = 0;
+};
+
+// Only plain data lives between setjmp and longjmp here (no destructors to skip): the scratch row
+// is owned by the caller. Returns false with check.message set when libpng fails. `header` is
+// filled once the header is read; `accept` decides (after the header) whether to decode the rows.
+bool png_decode_check(PngCheck& check, PngHeader& header, std::vector<png_byte>& row,
+                      bool (*accept)(const PngHeader&, void*), void* context) {
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &check, png_check_error, png_check_warning);
+  if (png == nullptr) {
+    std::snprintf(check.message, sizeof check.message, "%s", "out of memory");
+    return false;
+  }
+  png_infop info = png_create_info_struct(png);
+  if (setjmp(check.jump)) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    return false;
+  }
+  if (info == nullptr) png_error(png, "out of memory");
+  png_set_read_fn(png, &check, png_check_read);
+  png_read_info(png, info);
+  header.width = png_get_image_width(png, info);
+  header.height = png_get_image_height(png, info);
+  header.channels = png_get_channels(png, info);
+  if (!accept(header, context)) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    return true;
+  }
+  const int passes = png_set_interlace_handling(png);
+  png_read_update_info(png, info);
+  row.resize(png_get_rowbytes(png, info));
+  for (int pass = 0; pass < passes; ++pass)
+    for (png_uint_32 y = 0; y < header.height; ++y) png_read_row(png, row.data(), nullptr);
+  png_read_end(png, nullptr);
+  png_destroy_read_struct(&png, &info, nullptr);
+  return true;
+}
+
+bool is_png(std::span<const std::byte> bytes) {
+  return bytes.size() >= 8 && png_sig_cmp(reinterpret_cast<png_const_bytep>(bytes.data()), 0, 8) == 0;
+}
+
+void check_png(std::span<const std::byte> bytes, const std::string& name, const DecodeLimits& limits) {
+  PngCheck check;
+  check.bytes = bytes;
+  PngHeader header;
+  std::vector<png_byte> row;
+  struct Context {
+    const DecodeLimits& limits;
+    std::string refusal;
+  } context{limits, {}};
+  // The size is checked between the header and the rows, outside the setjmp frame (a throw must
+  // not cross libpng), by refusing the rows and remembering why.
+  auto accept = [](const PngHeader& h, void* c) {
+    auto& ctx = *static_cast<Context*>(c);
+    try {
+      check_size("", h.width, h.height, h.channels, ctx.limits);
+    } catch (const std::runtime_error& e) {
+      ctx.refusal = e.what();
+      return false;
+    }
+    return true;
+  };
+  if (!png_decode_check(check, header, row, accept, &context)) fail(name + ": cannot read the image: " + check.message);
+  if (!context.refusal.empty()) fail(name + context.refusal);
+}
+
 // Reads the first subimage of an opened input, validating its size first so that a header claiming
 // absurd dimensions never gets an allocation.
-Pixels read_opened(OIIO::ImageInput& input, const std::string& name, int max_dimension) {
+Pixels read_opened(OIIO::ImageInput& input, const std::string& name, const DecodeLimits& limits) {
   const OIIO::ImageSpec& spec = input.spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
-    fail(name + ": the image has no pixels (" + std::to_string(spec.width) + "x" + std::to_string(spec.height) + ", " +
-         std::to_string(spec.nchannels) + " channels)");
-  if (spec.width > max_dimension || spec.height > max_dimension)
-    fail(name + ": " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " is too large (at most " +
-         std::to_string(max_dimension) + " pixels per side)");
+  check_size(name, spec.width, spec.height, spec.nchannels, limits);
   if (spec.depth > 1) fail(name + ": volume images are not supported");
   Pixels pixels;
   pixels.width = spec.width;
@@ -49,7 +159,32 @@ Pixels read_opened(OIIO::ImageInput& input, const std::string& name, int max_dim
   return pixels;
 }
 
-Pixels read_file(const std::string& path, const std::string& format, int max_dimension) {
+Pixels decode_encoded(std::span<const std::byte> encoded, const std::string& format, const std::string& name,
+                      const DecodeLimits& limits);
+
+// The whole file, or nothing when it cannot be read (OIIO then says why).
+std::optional<std::vector<std::byte>> file_bytes(const std::string& path) {
+  std::ifstream file(path, std::ios::binary | std::ios::ate);
+  if (!file) return std::nullopt;
+  const std::streamoff size = file.tellg();
+  if (size < 0) return std::nullopt;
+  std::vector<std::byte> bytes(static_cast<std::size_t>(size));
+  file.seekg(0);
+  if (!file.read(reinterpret_cast<char*>(bytes.data()), size)) return std::nullopt;
+  return bytes;
+}
+
+bool has_png_signature(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  char magic[8] = {};
+  return file.read(magic, sizeof magic) && png_sig_cmp(reinterpret_cast<png_const_bytep>(magic), 0, 8) == 0;
+}
+
+Pixels read_file(const std::string& path, const std::string& format, const DecodeLimits& limits) {
+  // A PNG is checked by libpng and decoded from the same bytes (check_png says why): one read, so
+  // the file cannot change between the check and the decode.
+  if ((format.empty() || format == "png") && has_png_signature(path))
+    if (auto bytes = file_bytes(path)) return decode_encoded(*bytes, "png", path, limits);
   std::unique_ptr<OIIO::ImageInput> input;
   if (!format.empty()) {
     input = OIIO::ImageInput::create(format);
@@ -59,11 +194,12 @@ Pixels read_file(const std::string& path, const std::string& format, int max_dim
     input = OIIO::ImageInput::open(path);
   }
   if (!input) fail(path + ": cannot read the image: " + first_line(OIIO::geterror()));
-  return read_opened(*input, path, max_dimension);
+  return read_opened(*input, path, limits);
 }
 
-Pixels decode(std::span<const std::byte> encoded, const std::string& format, const std::string& name,
-              int max_dimension) {
+Pixels decode_encoded(std::span<const std::byte> encoded, const std::string& format, const std::string& name,
+                      const DecodeLimits& limits) {
+  if (is_png(encoded)) check_png(encoded, name, limits);
   OIIO::Filesystem::IOMemReader reader(encoded.data(), encoded.size());
   auto input = OIIO::ImageInput::create(format, false, nullptr, &reader);
   if (!input) fail(name + ": no " + format + " reader (" + first_line(OIIO::geterror()) + ")");
@@ -73,7 +209,7 @@ Pixels decode(std::span<const std::byte> encoded, const std::string& format, con
   config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
   OIIO::ImageSpec spec;
   if (!input->open(name, spec, config)) fail(name + ": cannot read the image: " + first_line(input->geterror()));
-  return read_opened(*input, name, max_dimension);
+  return read_opened(*input, name, limits);
 }
 
 bool has_writer(const std::string& format_or_file_name) {
@@ -138,7 +274,7 @@ const ModuleApi kApi{
     .abi = ModuleApi::kAbi,
     .size = sizeof(ModuleApi),
     .read_file = read_file,
-    .decode = decode,
+    .decode = decode_encoded,
     .has_writer = has_writer,
     .encode = encode,
     .text_size = text_size,

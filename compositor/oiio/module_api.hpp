@@ -14,12 +14,12 @@
 namespace nelf::image_library {
 
 struct ModuleApi {
-  static constexpr std::uint32_t kAbi = 1;  // bump when a signature or the table changes
+  static constexpr std::uint32_t kAbi = 2;  // bump when a signature or the table changes
   std::uint32_t abi = kAbi;
   std::size_t size = sizeof(ModuleApi);
-  Pixels (*read_file)(const std::string& path, const std::string& format, int max_dimension) = nullptr;
+  Pixels (*read_file)(const std::string& path, const std::string& format, const DecodeLimits& limits) = nullptr;
   Pixels (*decode)(std::span<const std::byte> encoded, const std::string& format, const std::string& name,
-                   int max_dimension) = nullptr;
+                   const DecodeLimits& limits) = nullptr;
   bool (*has_writer)(const std::string& format_or_file_name) = nullptr;
   std::optional<std::vector<unsigned char>> (*encode)(const Picture& picture, const EncodeOptions& options,
                                                       const std::string& path) = nullptr;

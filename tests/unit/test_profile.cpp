@@ -182,5 +182,20 @@ TEST(ProfileErrors, MissingFile) {
   }
 }
 
+TEST(ProfileErrors, ArraysAreShownOnOneLineAndCutShort) {
+  std::string text = minimal_lens_profile;
+  text.replace(text.find("resolution = [1280, 720]"), 24, "resolution = [\n  1280,\n  720,\n  3,\n]");
+  auto e = error_of(text);
+  EXPECT_NE(e.find("got [1280, 720, 3]"), std::string::npos) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  std::string many = "resolution = [";
+  for (int i = 0; i < 1000; ++i) many += std::to_string(i) + ",\n";
+  text = minimal_lens_profile;
+  text.replace(text.find("resolution = [1280, 720]"), 24, many + "]");
+  e = error_of(text);
+  EXPECT_NE(e.find("got [0, 1, 2, 3, 4, 5, 6, 7, ... (1000 values)]"), std::string::npos) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+}
+
 }  // namespace
 }  // namespace nelf

@@ -1,6 +1,10 @@
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <atomic>
+#include <cstdio>
 #include <string>
+#include <thread>
 
 #include "inputs/still_source.hpp"
 #include "support/image_files.hpp"
@@ -286,6 +290,84 @@ TEST(StillSource, BadMpo) {
   test::write_file(dir / "pair.mpo", left + jpeg_bytes(dir, filled_image(48, 32, kBluish), "r2.jpg"));
   EXPECT_NE(still_error(dir / "pair.mpo", {StereoLayout::sbs, std::nullopt, false}).find("does not apply"),
             std::string::npos);
+}
+
+TEST(StillSource, PixelLimitIsCheckedForEveryFormatAndView) {
+  TempDir dir;
+  write_test_image(dir / "photo.jpg", filled_image(300, 200, kReddish), 3, OIIO::TypeDesc::UINT8, "jpeg");
+  write_test_image(dir / "photo.tif", filled_image(300, 200, kReddish), 3);
+  write_test_image(dir / "photo.png", filled_image(300, 200, kReddish), 3);
+  for (const char* name : {"photo.jpg", "photo.tif", "photo.png"}) {
+    SCOPED_TRACE(name);
+    try {
+      read_image_file(dir / name, 59999);
+      ADD_FAILURE() << "read over the limit";
+    } catch (const StillError& e) {
+      EXPECT_EQ(std::string(e.what()), (dir / name).string() +
+                                           ": 300x200 is 60000 pixels, more than the limit of 59999 (--max-pixels "
+                                           "raises it)");
+    }
+    EXPECT_EQ(read_image_file(dir / name, 60000).width(), 300);
+  }
+  // Each view of an MPO is one image of the limit.
+  const std::string left = jpeg_bytes(dir, filled_image(300, 200, kReddish), "l.jpg");
+  const std::string right = jpeg_bytes(dir, filled_image(300, 200, kBluish), "r.jpg");
+  test::write_file(dir / "pair.mpo", left + right);
+  StillOptions options;
+  options.max_pixels = 59999;
+  EXPECT_NE(still_error(dir / "pair.mpo", options).find("pair.mpo (left image): 300x200 is 60000 pixels"),
+            std::string::npos)
+      << still_error(dir / "pair.mpo", options);
+  options.max_pixels = 60000;
+  EXPECT_EQ(still_error(dir / "pair.mpo", options), "");
+}
+
+// A damaged PNG is reported in its error's text only: nothing is printed (libpng's default handler
+// would), and stderr is not muted meanwhile either, which would swallow what other threads print.
+TEST(StillSource, DamagedPngPrintsNothingAndMutesNothing) {
+  TempDir dir;
+  Image noise(1500, 1500);  // big enough to take a while to decode
+  unsigned state = 1;
+  for (Rgba& px : noise.pixels()) {
+    state = state * 1103515245u + 12345u;
+    px = {static_cast<float>(state >> 24) / 255.f, static_cast<float>((state >> 16) & 255) / 255.f, 0.2f, 1.f};
+  }
+  write_test_image(dir / "whole.png", noise, 3);
+  std::string png = test::read_file(dir / "whole.png");
+  for (std::size_t i = png.size() - 2000; i < png.size() - 1000; ++i) png[i] = static_cast<char>(~png[i]);
+  test::write_file(dir / "damaged.png", png);
+
+  // fd 2 into a file for the duration; a second thread prints numbered lines all along.
+  std::fflush(stderr);
+  const int saved = ::dup(STDERR_FILENO);
+  ASSERT_GE(saved, 0);
+  const auto captured = dir / "stderr.txt";
+  std::FILE* sink = std::fopen(captured.c_str(), "w");
+  ASSERT_NE(sink, nullptr);
+  ::dup2(::fileno(sink), STDERR_FILENO);
+  std::atomic<bool> done{false};
+  int printed = 0;
+  std::thread other([&] {
+    while (!done) {
+      const std::string line = "tick " + std::to_string(printed++) + "\n";
+      [[maybe_unused]] const auto written = ::write(STDERR_FILENO, line.data(), line.size());
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+  });
+  std::string error;
+  for (int i = 0; i < 5; ++i) error = read_error(dir / "damaged.png");
+  done = true;
+  other.join();
+  ::dup2(saved, STDERR_FILENO);
+  ::close(saved);
+  std::fclose(sink);
+
+  EXPECT_NE(error.find("damaged.png: cannot read the image: "), std::string::npos) << error;
+  const std::string out = test::read_file(captured);
+  EXPECT_EQ(out.find("libpng"), std::string::npos) << out;
+  std::string expected;
+  for (int i = 0; i < printed; ++i) expected += "tick " + std::to_string(i) + "\n";
+  EXPECT_EQ(out, expected) << "lines printed by another thread were lost";
 }
 
 }  // namespace
