@@ -82,8 +82,11 @@ class SourcePacketCarrier {
       const AVStream* stream = format_->streams[packet_->stream_index];
       const std::int64_t ts = packet_->pts != AV_NOPTS_VALUE ? packet_->pts : packet_->dts;
       const double t = ts == AV_NOPTS_VALUE ? 0.0 : ts * av_q2d(stream->time_base) - origin_s_;
-      if (until_s && t > *until_s) return;  // keep it for later
       const bool wanted = std::find(carried.begin(), carried.end(), packet_->stream_index) != carried.end();
+      // Only a carried packet waits for later: in MPEG-TS the audio lies behind the video in the
+      // file (the muxer gathers several audio frames per PES packet), so stopping at a video
+      // packet would leave out audio that belongs before it.
+      if (wanted && until_s && t > *until_s) return;  // keep it for later
       if (wanted && t >= -1e-6 && (!end_s || t < *end_s)) {
         // Shift to output time (the conversion starts at 0).
         const std::int64_t shift = llround(origin_s_ / av_q2d(stream->time_base));

@@ -84,6 +84,10 @@ std::filesystem::path temporary_path_for(const std::filesystem::path& output) {
          fmt::format(".{}.nelf-{}{}", output.stem().string(), ::getpid(), output.extension().string());
 }
 
+// Writes a packet whose timestamps are in `time_base`; the muxer rescales them to its stream's time
+// base once its header has fixed it.
+using PacketWriter = std::function<void(AVPacket*, AVRational time_base)>;
+
 // An AAC track fed with samples of any format: they are converted (swresample) to the encoder's
 // planar float, queued, and encoded in the encoder's frame size.
 class AudioTrack {
@@ -112,8 +116,20 @@ class AudioTrack {
   AVStream* stream() const { return stream_; }
 
   // Queues samples described by (format, layout, rate); converts them to the encoder's format.
+  // `start_s` is the time of the first sample pushed, read on the first call only (later samples
+  // follow on without gaps).
   void push(const uint8_t* const* data, int count, AVSampleFormat format, const AVChannelLayout& layout, int rate,
-            const std::function<void(AVPacket*)>& write) {
+            double start_s, const PacketWriter& write) {
+    if (!started_) {
+      // The encoder's first packet is stamped `initial_padding` samples before its first input
+      // sample (its priming). Matroska cannot start a track before 0, so the muxer would shift
+      // every stream by it and the video would no longer start at 0. Instead the first
+      // `initial_padding` samples are left out and the rest keep their time: the first packet is
+      // stamped `start_s` and everything after plays in sync; what is lost is the first ~21 ms.
+      skip_ = std::max(0, encoder_->initial_padding);
+      next_pts_ = std::llround(start_s * encoder_->sample_rate) + skip_;
+      started_ = true;
+    }
     if (!resampler_ || format != in_format_ || rate != in_rate_) {
       SwrContext* raw = nullptr;
       AVChannelLayout in_layout{};  // FFmpeg 5.1 takes a non-const layout
@@ -136,17 +152,20 @@ class AudioTrack {
     for (auto& p : planes) out.push_back(reinterpret_cast<uint8_t*>(p.data()));
     const int converted = swr_convert(resampler_.get(), out.data(), capacity, const_cast<const uint8_t**>(data), count);
     if (converted < 0) throw std::runtime_error("audio conversion failed");
-    av_audio_fifo_write(fifo_.get(), reinterpret_cast<void**>(out.data()), converted);
+    const int skipped = std::min(skip_, converted);
+    skip_ -= skipped;
+    for (auto& plane : out) plane += static_cast<std::ptrdiff_t>(skipped) * static_cast<std::ptrdiff_t>(sizeof(float));
+    av_audio_fifo_write(fifo_.get(), reinterpret_cast<void**>(out.data()), converted - skipped);
     encode_available(false, write);
   }
 
-  void flush(const std::function<void(AVPacket*)>& write) {
+  void flush(const PacketWriter& write) {
     encode_available(true, write);
     drain(true, write);
   }
 
  private:
-  void encode_available(bool final_block, const std::function<void(AVPacket*)>& write) {
+  void encode_available(bool final_block, const PacketWriter& write) {
     const int frame_size = encoder_->frame_size > 0 ? encoder_->frame_size : 1024;
     while (av_audio_fifo_size(fifo_.get()) >= frame_size || (final_block && av_audio_fifo_size(fifo_.get()) > 0)) {
       const int n = std::min(frame_size, av_audio_fifo_size(fifo_.get()));
@@ -165,16 +184,15 @@ class AudioTrack {
     }
   }
 
-  void drain(bool flush, const std::function<void(AVPacket*)>& write) {
+  void drain(bool flush, const PacketWriter& write) {
     if (flush) avcodec_send_frame(encoder_.get(), nullptr);
     PacketPtr packet(av_packet_alloc());
     for (;;) {
       const int r = avcodec_receive_packet(encoder_.get(), packet.get());
       if (r == AVERROR(EAGAIN) || r == AVERROR_EOF) return;
       if (r < 0) throw std::runtime_error(fmt::format("audio encoding failed: {}", av_error(r)));
-      av_packet_rescale_ts(packet.get(), encoder_->time_base, stream_->time_base);
       packet->stream_index = stream_->index;
-      write(packet.get());
+      write(packet.get(), encoder_->time_base);
     }
   }
 
@@ -185,6 +203,8 @@ class AudioTrack {
   AVStream* stream_ = nullptr;
   AVSampleFormat in_format_ = AV_SAMPLE_FMT_NONE;
   int in_rate_ = 0;
+  bool started_ = false;
+  int skip_ = 0;  // priming samples still to leave out
   int64_t next_pts_ = 0;
 };
 
@@ -213,7 +233,7 @@ struct VideoEncoder::State {
   std::unique_ptr<AudioTrack> generated_audio;  // add_audio_track()
   int generated_channels = 0, generated_rate = 0;
   std::vector<std::unique_ptr<ReencodedStream>> reencoded;  // by source stream index, null when copied/dropped
-  std::function<void(AVPacket*)> writer = [this](AVPacket* p) { write(p); };
+  PacketWriter writer = [this](AVPacket* p, AVRational time_base) { write(p, time_base); };
   int64_t last_pts = AV_NOPTS_VALUE;
 
   void drain(bool flush) {
@@ -222,9 +242,8 @@ struct VideoEncoder::State {
       const int r = avcodec_receive_packet(encoder.get(), packet.get());
       if (r == AVERROR(EAGAIN) || r == AVERROR_EOF) return;
       if (r < 0) throw std::runtime_error(fmt::format("{}: encoding failed: {}", output.string(), av_error(r)));
-      av_packet_rescale_ts(packet.get(), encoder->time_base, video_stream->time_base);
       packet->stream_index = video_stream->index;
-      write(packet.get());
+      write(packet.get(), encoder->time_base);
     }
   }
 
@@ -237,8 +256,12 @@ struct VideoEncoder::State {
     header_written = true;
   }
 
-  void write(AVPacket* p) {
+  // `p`'s timestamps are in `time_base`. They are rescaled only after the header is written:
+  // avformat_write_header may change a stream's time base (Matroska: 1/1000, MPEG-TS: 1/90000), and
+  // a packet rescaled to the time base asked for before it would be read in the one set after it.
+  void write(AVPacket* p, AVRational time_base) {
     ensure_header();
+    av_packet_rescale_ts(p, time_base, muxer->streams[p->stream_index]->time_base);
     const int r = av_interleaved_write_frame(muxer.get(), p);
     if (r < 0)
       throw std::runtime_error(fmt::format("{}: cannot write: {}", output.string(),
@@ -443,17 +466,18 @@ void VideoEncoder::write_source_packet(AVPacket* packet, int source_stream) {
     ReencodedStream& re = *s.reencoded[static_cast<std::size_t>(source_stream)];
     if (avcodec_send_packet(re.decoder.get(), packet) < 0) return;  // a damaged audio packet is skipped
     while (avcodec_receive_frame(re.decoder.get(), re.frame.get()) >= 0) {
+      // The packets were shifted to output time, so the decoded frames' timestamps are output time.
+      const int64_t pts = re.frame->best_effort_timestamp;
+      const double start_s = pts == AV_NOPTS_VALUE ? 0.0 : static_cast<double>(pts) * av_q2d(re.decoder->pkt_timebase);
       re.track->push(re.frame->extended_data, re.frame->nb_samples, static_cast<AVSampleFormat>(re.frame->format),
-                     re.frame->ch_layout, re.frame->sample_rate, s.writer);
+                     re.frame->ch_layout, re.frame->sample_rate, start_s, s.writer);
       av_frame_unref(re.frame.get());
     }
     return;
   }
-  av_packet_rescale_ts(packet, s.source_time_bases[static_cast<std::size_t>(source_stream)],
-                       s.muxer->streams[out_index]->time_base);
   packet->stream_index = out_index;
   packet->pos = -1;
-  s.write(packet);
+  s.write(packet, s.source_time_bases[static_cast<std::size_t>(source_stream)]);
 }
 
 void VideoEncoder::add_audio_track(int sample_rate, int channels) {
@@ -472,7 +496,7 @@ void VideoEncoder::write_audio(const float* interleaved, int sample_count) {
   const uint8_t* data[1] = {reinterpret_cast<const uint8_t*>(interleaved)};
   AVChannelLayout layout;
   av_channel_layout_default(&layout, s.generated_channels);
-  s.generated_audio->push(data, sample_count, AV_SAMPLE_FMT_FLT, layout, s.generated_rate, s.writer);
+  s.generated_audio->push(data, sample_count, AV_SAMPLE_FMT_FLT, layout, s.generated_rate, 0.0, s.writer);
 }
 
 void VideoEncoder::finish() {

@@ -86,7 +86,10 @@ class FileFrameSource final : public StereoFrameSource {
                                   *source_.info().duration_s),
                       1);
     if (!pending_) throw UserError(fmt::format("{}: no video frame could be decoded", r.input), 1);
-    origin_s_ = source_.info().start_time_s + r.start_s.value_or(0.0);
+    // Output time 0 is the first frame delivered, not the requested start: after a seek it can be
+    // up to half a frame before or after it, and a first frame stamped below 0 makes muxers shift
+    // every stream (Matroska) so that neither starts at 0. The audio is cut at the same point.
+    origin_s_ = pending_->pts_s;
     alt_width_ = pending_->width;
     alt_height_ = pending_->height;
     alt_aspect_ = pending_->display_aspect;

@@ -236,6 +236,10 @@ struct VideoSource::Impl {
   std::optional<StereoMetadata> frame_stereo;
   std::optional<double> pending_after_seek;
   bool seeked = false;  // frames before this time (s) are skipped after seek()
+  // The timeline actually read: the latest end (pts + duration) of a packet of any stream, and the
+  // first and last timestamps of the decoded video frames (count_missing_frames).
+  std::optional<double> packets_end_s;
+  std::optional<double> first_frame_s, last_frame_s;
 
   [[noreturn]] void fail(const std::string& what) const { throw VideoError(fmt::format("{}: {}", info.path, what)); }
 
@@ -400,17 +404,28 @@ struct VideoSource::Impl {
   }
 
   // Frames the container promised but that never arrived (a truncated file). With an index
-  // (nb_frames) the count is exact; from duration × rate it is an estimate, so a one-frame
-  // difference from rounding is not reported.
+  // (nb_frames) the count is exact. Without one, the container's duration is compared with how far
+  // the packets read reached (any stream: audio often runs past the video), and the time missing is
+  // counted in the stream's own mean frame interval. A frame count from duration × nominal rate
+  // would call every variable-frame-rate file damaged; a shortfall of one frame is rounding.
   void count_missing_frames() {
     if (seeked) return;  // the container's promise counts from the start, which was skipped
     if (info.frame_count) {
       stats.missing_frames = std::max<std::int64_t>(0, *info.frame_count - stats.frames_decoded);
-    } else if (info.duration_s && info.fps > 0.0) {
-      const auto expected = static_cast<std::int64_t>(std::llround(*info.duration_s * info.fps));
-      const std::int64_t shortfall = expected - stats.frames_decoded;
-      stats.missing_frames = shortfall > 1 ? shortfall : 0;
+      return;
     }
+    // A duration guessed from the bit rate promises nothing.
+    if (format->duration == AV_NOPTS_VALUE || format->duration <= 0 ||
+        format->duration_estimation_method == AVFMT_DURATION_FROM_BITRATE || !packets_end_s)
+      return;
+    const double start = format->start_time != AV_NOPTS_VALUE ? static_cast<double>(format->start_time) : 0.0;
+    const double promised_end = (start + static_cast<double>(format->duration)) / AV_TIME_BASE;
+    double interval = info.fps > 0.0 ? 1.0 / info.fps : 0.0;
+    if (stats.frames_decoded >= 2 && first_frame_s && last_frame_s && *last_frame_s > *first_frame_s)
+      interval = (*last_frame_s - *first_frame_s) / static_cast<double>(stats.frames_decoded - 1);
+    if (interval <= 0.0) return;
+    const auto shortfall = static_cast<std::int64_t>(std::llround((promised_end - *packets_end_s) / interval));
+    stats.missing_frames = shortfall > 1 ? shortfall : 0;
   }
 
   void colour_of(const AVFrame& decoded, AVPixelFormat& source_format, int& colorspace, bool& full_range) const {
@@ -622,6 +637,11 @@ struct VideoSource::Impl {
         consecutive_errors = 0;
         ++stats.frames_decoded;
         if ((frame->flags & AV_FRAME_FLAG_CORRUPT) != 0 || frame->decode_error_flags != 0) ++stats.decode_errors;
+        if (frame->best_effort_timestamp != AV_NOPTS_VALUE) {
+          const double t = static_cast<double>(frame->best_effort_timestamp) * av_q2d(stream->time_base);
+          first_frame_s = std::min(first_frame_s.value_or(t), t);
+          last_frame_s = std::max(last_frame_s.value_or(t), t);
+        }
         VideoFrame out = convert(*frame);
         av_frame_unref(last.get());
         av_frame_move_ref(last.get(), frame.get());
@@ -649,6 +669,11 @@ struct VideoSource::Impl {
         draining = true;
         avcodec_send_packet(codec.get(), nullptr);
         continue;
+      }
+      if (const std::int64_t ts = packet->pts != AV_NOPTS_VALUE ? packet->pts : packet->dts; ts != AV_NOPTS_VALUE) {
+        const double end = static_cast<double>(ts + std::max<std::int64_t>(packet->duration, 0)) *
+                           av_q2d(format->streams[packet->stream_index]->time_base);
+        packets_end_s = std::max(packets_end_s.value_or(end), end);
       }
       if (packet->stream_index == info.stream_index) {
         // The demuxer's parser reads each packet's header (H.264/HEVC/MPEG-2 sequence headers):
