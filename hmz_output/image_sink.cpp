@@ -143,7 +143,8 @@ void check_image_writable(const fs::path& path, const ImageWriteOptions& options
   if (options.bits == 16 && (*format == FileFormat::jpeg || *format == FileFormat::exr))
     throw ImageWriteError(fmt::format("cannot write {}: 16-bit output needs .png or .tif", path.string()));
   std::error_code ec;
-  if (!options.overwrite && fs::exists(path, ec))
+  // symlink_status: a dangling symlink is an existing name too, replaced only with `overwrite`.
+  if (!options.overwrite && fs::exists(fs::symlink_status(path, ec)))
     throw ImageWriteError(fmt::format("{} exists; pass -y to overwrite", path.string()));
   if (fs::is_directory(path, ec))
     throw ImageWriteError(fmt::format("cannot write {}: it is a directory", path.string()));
