@@ -106,7 +106,7 @@ class TemporaryFile {
   fs::path path_;
 };
 
-// Holds back SIGINT, SIGTERM and SIGHUP of the calling thread while the file is written and renamed,
+// Holds back SIGINT, SIGTERM, SIGHUP and SIGQUIT of the calling thread while the file is written and renamed,
 // so that Ctrl-C cannot leave a temporary file behind; a pending signal is delivered when the block
 // ends, after the file is complete (or removed). Lasts a fraction of a second for a frame.
 class DeferredTermination {
@@ -117,6 +117,7 @@ class DeferredTermination {
     sigaddset(&block, SIGINT);
     sigaddset(&block, SIGTERM);
     sigaddset(&block, SIGHUP);
+    sigaddset(&block, SIGQUIT);
     active_ = ::pthread_sigmask(SIG_BLOCK, &block, &previous_) == 0;
   }
   ~DeferredTermination() {

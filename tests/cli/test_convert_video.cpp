@@ -552,6 +552,43 @@ TEST(ConvertVideo, TerminateLeavesNothing) {
   }
 }
 
+// A closed terminal (SIGHUP) and SIGQUIT (Ctrl-\\) stop a conversion as Ctrl-C does: status 130,
+// one line, nothing left of the output (SIGHUP used to kill nelf and leave the temporary file;
+// SIGQUIT, which a shell without job control ignores for background commands, went unheard).
+TEST(ConvertVideo, HangupAndQuitLeaveNothing) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  for (const std::string signal : {"HUP", "QUIT"})
+    for (const std::string output : {"out.mkv", "frame_%04d.png"}) {
+      SCOPED_TRACE(signal + " " + output);
+      const auto r =
+          run_command(std::string(NELF_BINARY) + " convert synthetic:duration=30,size=320x180 " + q(dir / output) +
+                      " --profile " + q(profile) + " & pid=$!; sleep 2; ls -A " + q(dir.path()) + "; kill -" + signal +
+                      " $pid; "
+                      "(sleep 15; kill -KILL $pid) 2>/dev/null & guard=$!; "
+                      "wait $pid; status=$?; kill $guard; echo status $status");
+      if (output == "out.mkv") {
+        EXPECT_NE(r.out.find(".out.nelf-"), std::string::npos) << "no temporary file while converting: " << r.out;
+      } else {
+        EXPECT_NE(r.out.find("frame_0001.png"), std::string::npos) << "no frame written before the signal: " << r.out;
+      }
+      EXPECT_NE(r.out.find("status 130\n"), std::string::npos) << r.out << r.err;
+      EXPECT_NE(r.err.find("nelf: interrupted: no output written\n"), std::string::npos) << r.err;
+      EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"small.toml"}));
+    }
+}
+
+// Under nohup (SIGHUP ignored when nelf starts) a closed terminal does not stop the conversion.
+TEST(ConvertVideo, IgnoredHangupKeepsConverting) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  const auto r = run_command("trap '' HUP; " + std::string(NELF_BINARY) + " convert synthetic:duration=3,size=160x90 " +
+                             q(dir / "out.mkv") + " --quiet --codec ffv1 --profile " + q(profile) +
+                             " & pid=$!; sleep 1; kill -HUP $pid; wait $pid; echo status $?");
+  EXPECT_EQ(r.out, "status 0\n") << r.err;
+  EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"out.mkv", "small.toml"}));
+}
+
 // A full disk, made real with a file size limit: writes past `ulimit -f` fail with EFBIG exactly as
 // they fail with ENOSPC on a full file system (nelf ignores SIGXFSZ, which would otherwise kill it
 // mid-file). Both sinks: one line naming the file and the cause, status 1, nothing left behind —
