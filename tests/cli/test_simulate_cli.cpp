@@ -222,7 +222,7 @@ TEST(SimulateCli, OutputOntoTheInputIsRefused) {
   const std::string bytes = read_file(f.still);
   const std::string still = shell_quote(f.still.string());
   const std::string head = "simulate " + still + " --profile " + shell_quote(f.profile.string());
-  for (const std::string args :
+  for (const std::string& args :
        {" -o " + still, " -o " + shell_quote(f.retina.string()) + " --ideal " + still,
         " -o " + shell_quote(f.retina.string()) + " --sweep " + shell_quote((f.dir / "still.csv").string())}) {
     SCOPED_TRACE(args);
