@@ -561,12 +561,14 @@ TEST(ConvertVideo, HangupAndQuitLeaveNothing) {
   for (const std::string signal : {"HUP", "QUIT"})
     for (const std::string output : {"out.mkv", "frame_%04d.png"}) {
       SCOPED_TRACE(signal + " " + output);
-      const auto r =
-          run_command(std::string(NELF_BINARY) + " convert synthetic:duration=30,size=320x180 " + q(dir / output) +
-                      " --profile " + q(profile) + " & pid=$!; sleep 2; ls -A " + q(dir.path()) + "; kill -" + signal +
-                      " $pid; "
-                      "(sleep 15; kill -KILL $pid) 2>/dev/null & guard=$!; "
-                      "wait $pid; status=$?; kill $guard; echo status $status");
+      // The signal once the output is being written (the temporary file, or the first frame).
+      const std::string written = output == "out.mkv" ? ".out.nelf-" : "frame_0001.png";
+      const auto r = run_command(
+          std::string(NELF_BINARY) + " convert synthetic:duration=30,size=320x180 " + q(dir / output) + " --profile " +
+          q(profile) + " & pid=$!; i=0; while [ $i -lt 200 ] && ! ls -A " + q(dir.path()) + " | grep -q " +
+          shell_quote(written) + "; do sleep 0.1; i=$((i+1)); done; ls -A " + q(dir.path()) + "; kill -" + signal +
+          " $pid; (sleep 15; kill -KILL $pid) 2>/dev/null & guard=$!; wait $pid; status=$?; kill $guard; echo status "
+          "$status");
       if (output == "out.mkv") {
         EXPECT_NE(r.out.find(".out.nelf-"), std::string::npos) << "no temporary file while converting: " << r.out;
       } else {
