@@ -22,7 +22,7 @@ struct CalibrateSession {
   std::string save;       // .toml path written on w and at the end ("" = nowhere)
 };
 
-// Runs until q/Esc, the window is closed or SIGINT/SIGTERM; saves to session.save (when given) on
+// Runs until q/Esc, the window is closed or an interrupt (app/interrupt.hpp); saves to session.save (when given) on
 // w and at the end, saying where on stdout. Throws UserError for a display that cannot open.
 void run_calibrate_session(const CalibrateSession& session);
 

@@ -13,6 +13,7 @@
 
 #include "app/calibrate_session.hpp"
 #include "app/commands.hpp"
+#include "app/input_files.hpp"
 #include "compositor/profile.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/image_sink.hpp"
@@ -81,6 +82,9 @@ void write_pattern_image(const CalibrateArgs& args) {
         "--save keeps what the keys adjusted and needs a window (--output window, fullscreen, kms or "
         "quad-buffer), not an image file",
         2);
+  InputFiles inputs;
+  inputs.add(args.profile, "the --profile");
+  inputs.refuse_as_output(args.output);
   const TestPattern pattern = parse_pattern_option(args.pattern);
   const CompositorOptions options = compositor_options(args);
   const Profile profile = load_profile(args.profile);  // ProfileError -> status 2 in main()

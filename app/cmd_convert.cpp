@@ -11,6 +11,7 @@
 #include <filesystem>
 #include "app/commands.hpp"
 #include "app/convert_video.hpp"
+#include "app/input_files.hpp"
 #include "compositor/make_compositor.hpp"
 #include "compositor/profile.hpp"
 #include "hmz_output/image_sink.hpp"
@@ -77,8 +78,9 @@ ConvertPlan plan_convert(const ConvertArgs& args) {
   return plan;
 }
 
-void run_convert_video(const ConvertArgs& args) {
+void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
   VideoConvertRequest r;
+  r.inputs = inputs;
   r.input = args.input;
   r.right = args.right;
   r.output = args.output;
@@ -111,7 +113,9 @@ void run_convert_video(const ConvertArgs& args) {
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec))
     throw UserError(fmt::format("{}: cannot write: directory {} does not exist", args.output, dir.string()), 1);
-  if (!is_image_sequence_pattern(args.output) && std::filesystem::exists(out, ec) && !args.overwrite)
+  // symlink_status: a dangling symlink is an existing name too (replacing it needs -y, as for stills).
+  if (!is_image_sequence_pattern(args.output) && std::filesystem::exists(std::filesystem::symlink_status(out, ec)) &&
+      !args.overwrite)
     throw UserError(fmt::format("{}: already exists; pass -y to overwrite", args.output), 1);
   if (!args.quiet) quiet_ffmpeg_logs(true);
   convert_video(r);
@@ -119,7 +123,13 @@ void run_convert_video(const ConvertArgs& args) {
 
 void run_convert(const ConvertArgs& args) {
   quiet_ffmpeg_logs(true);
-  if (!is_still_image(args.input)) return run_convert_video(args);
+  // Before anything else, -y included: no output over what is being read.
+  InputFiles inputs;
+  inputs.add(args.input, "the input");
+  inputs.add(args.right, "the --right view");
+  inputs.add(args.profile, "the --profile");
+  inputs.refuse_as_output(args.output);
+  if (!is_still_image(args.input)) return run_convert_video(args, inputs);
   const ConvertPlan plan = plan_convert(args);
   StillStereo still;
   try {

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.hpp"
+#include "app/input_files.hpp"
 #include "compositor/design.hpp"
 #include "compositor/design_plot.hpp"
 #include "compositor/profile.hpp"
@@ -19,6 +20,11 @@ struct DesignOptions {
 };
 
 void run_design(const DesignOptions& options) {
+  if (!options.plot_path.empty()) {
+    InputFiles inputs;
+    inputs.add(options.profile, "the --profile");
+    inputs.refuse_as_output(options.plot_path);
+  }
   const Profile profile = load_profile(options.profile);
   const DesignReport report = design_report(profile);
   // Plot first: if the file cannot be written, nothing is printed and the status says so.

@@ -15,6 +15,7 @@
 #include <fmt/ranges.h>
 #include "app/commands.hpp"
 #include "app/heatmap.hpp"
+#include "app/input_files.hpp"
 #include "compositor/eye_simulator.hpp"
 #include "compositor/make_compositor.hpp"
 #include "compositor/mapping.hpp"
@@ -169,6 +170,14 @@ void run_simulate(const SimulateArgs& args) {
     throw UserError(fmt::format("--pupil-mm must be > 0, got {}", *args.pupil_mm), 2);
   if (!args.sweep.empty() && std::filesystem::path(args.sweep).extension() == ".png")
     throw UserError(fmt::format("--sweep '{}' is the CSV table; the heatmap goes beside it as .png", args.sweep), 2);
+  InputFiles inputs;
+  inputs.add(args.input, "the input");
+  inputs.add(args.right, "the --right view");
+  inputs.add(args.profile, "the --profile");
+  for (const std::string& output : {args.output, args.ideal, args.sweep})
+    if (!output.empty()) inputs.refuse_as_output(output);
+  if (!args.sweep.empty())
+    inputs.refuse_as_output(std::filesystem::path(args.sweep).replace_extension(".png").string());
   check_writable(args.output, "--output");
   check_writable(args.ideal, "--ideal");
   check_writable(args.sweep, "--sweep");

@@ -162,7 +162,8 @@ class EncodedFileSink final : public FrameSink {
 // frames_%05d.png: one image per frame. Written files are removed again unless finish() is reached.
 class ImageSequenceSink final : public FrameSink {
  public:
-  ImageSequenceSink(const VideoConvertRequest& r) : pattern_(r.output), options_{r.encoder.overwrite, 8} {}
+  ImageSequenceSink(const VideoConvertRequest& r)
+      : pattern_(r.output), inputs_(r.inputs), options_{r.encoder.overwrite, 8} {}
   ~ImageSequenceSink() override {
     if (finished_) return;
     std::error_code ec;
@@ -170,6 +171,8 @@ class ImageSequenceSink final : public FrameSink {
   }
   void write(const PackedFrame& frame) override {
     const std::string name = fmt::sprintf(pattern_, static_cast<int>(written_.size()) + 1);
+    // Any frame's name may be an input (out_%05d.png expanding to an input's name, or a link to it).
+    inputs_.refuse_as_output(name);
     Image image(frame.width, frame.height);
     const std::size_t bpp = bytes_per_pixel(frame.bits);
     float* out = image.data();
@@ -194,6 +197,7 @@ class ImageSequenceSink final : public FrameSink {
 
  private:
   std::string pattern_;
+  const InputFiles& inputs_;
   ImageWriteOptions options_;
   std::vector<std::filesystem::path> written_;
   bool finished_ = false;

@@ -3,6 +3,7 @@
 #include <optional>
 #include <string>
 
+#include "app/input_files.hpp"
 #include "compositor/compositor.hpp"
 #include "compositor/profile.hpp"
 #include "hmz_output/signal.hpp"
@@ -16,6 +17,7 @@ struct VideoConvertRequest {
   std::string input;   // a media file or `synthetic:[options]`
   std::string right;   // second input for layout pair
   std::string output;  // a video file, or an image sequence pattern such as frames_%05d.png
+  InputFiles inputs;   // what no output file may replace (each frame of a sequence is checked)
   Profile profile;
   Signal signal;
   CompositorOptions compositor;

@@ -1,5 +1,7 @@
 #include "app/interrupt.hpp"
 
+#include <iterator>
+
 namespace nelf::app {
 
 std::atomic<bool> interrupted{false};
@@ -13,13 +15,20 @@ InterruptGuard::InterruptGuard() {
   struct sigaction action {};
   action.sa_handler = on_interrupt;
   sigemptyset(&action.sa_mask);
-  sigaction(SIGINT, &action, &previous_int_);
-  sigaction(SIGTERM, &action, &previous_term_);
+  for (std::size_t i = 0; i < std::size(interrupt_signals); ++i) {
+    const int signal = interrupt_signals[i];
+    sigaction(signal, nullptr, &previous_[i]);
+    // nohup (or a parent) ignoring SIGHUP means "keep running when the terminal goes". SIGINT and
+    // SIGQUIT stay handled even when ignored: a shell without job control ignores them for every
+    // background command, which must still stop on `kill -INT`.
+    if (signal == SIGHUP && previous_[i].sa_handler == SIG_IGN) continue;
+    sigaction(signal, &action, nullptr);
+  }
 }
 
 InterruptGuard::~InterruptGuard() {
-  sigaction(SIGINT, &previous_int_, nullptr);
-  sigaction(SIGTERM, &previous_term_, nullptr);
+  for (std::size_t i = 0; i < std::size(interrupt_signals); ++i)
+    sigaction(interrupt_signals[i], &previous_[i], nullptr);
 }
 
 }  // namespace nelf::app

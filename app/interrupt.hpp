@@ -1,13 +1,19 @@
 #pragma once
-// SIGINT/SIGTERM for long-running commands (convert, play): a flag every stage polls instead of
-// dying mid-write, so that the command cleans up and exits 130.
+// SIGINT, SIGTERM, SIGHUP and SIGQUIT for long-running commands (convert, play): a flag every stage
+// polls instead of dying mid-write, so that the command cleans up and exits 130. One status for
+// all four, as ffmpeg exits with one status (255) for every signal it stops on: a script checks
+// one number for "stopped before the end". A closed terminal (SIGHUP) is such a stop too, except
+// under nohup: an ignored SIGHUP stays ignored.
 #include <atomic>
 #include <csignal>
 
 namespace nelf::app {
 
-// Set by SIGINT/SIGTERM while an InterruptGuard is alive.
+// Set by SIGINT/SIGTERM/SIGHUP/SIGQUIT while an InterruptGuard is alive.
 extern std::atomic<bool> interrupted;
+
+// The signals an InterruptGuard turns into `interrupted`.
+inline constexpr int interrupt_signals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
 
 // Installs the handlers for its lifetime (clearing the flag) and restores the previous ones.
 class InterruptGuard {
@@ -18,8 +24,7 @@ class InterruptGuard {
   InterruptGuard& operator=(const InterruptGuard&) = delete;
 
  private:
-  struct sigaction previous_int_ {};
-  struct sigaction previous_term_ {};
+  struct sigaction previous_[std::size(interrupt_signals)]{};
 };
 
 }  // namespace nelf::app

@@ -1,8 +1,11 @@
 // nelf: shows stereo content on near-eye light field displays. See README.md.
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <string>
+#include <system_error>
 
 #include "app/commands.hpp"
 #include "compositor/profile.hpp"
@@ -16,6 +19,19 @@ constexpr nelf::app::CommandRegistrar registrars[] = {
     nelf::app::add_calibrate_command,
 };
 
+// The status of a program that SIGPIPE ended, without the signal: the reader of nelf's output went
+// away (`nelf probe --json IN | head -c1`), after nelf cleaned up as for any other failure.
+constexpr int broken_pipe_status = 128 + SIGPIPE;
+
+// The one line of a failure. Never throws: stderr may be a closed pipe or a terminal that is gone,
+// and a throw from a catch handler would abort nelf instead of returning its status.
+// Every message goes through printable(): file names, profile keys and values and metadata in it
+// come from outside and may hold newlines or terminal escape sequences.
+void print_error_line(const std::string& message) {
+  const std::string line = "nelf: " + nelf::printable(message) + "\n";
+  std::fwrite(line.data(), 1, line.size(), stderr);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -23,6 +39,11 @@ int main(int argc, char** argv) {
   // middle of a file, leaving it half-written; ignored, the write fails with EFBIG, which every sink
   // reports in one line and cleans up after, as it does for a full disk (ENOSPC).
   std::signal(SIGXFSZ, SIG_IGN);
+  // Likewise a write to a pipe nobody reads any more (stdout into `head`, stderr into a closed
+  // pager) would kill nelf with SIGPIPE mid-conversion, leaving its temporary output behind.
+  // Ignored, the write fails with EPIPE: a diagnostic write is dropped, and EPIPE on an output
+  // (stdout, or any sink writing to a pipe) unwinds like any failure, cleaning up, and ends quietly.
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"nelf: watch 3D movies and play stereo games on near-eye light field displays", "nelf"};
   app.set_version_flag("--version", fmt::format("nelf {}", NELF_VERSION));
   app.require_subcommand(1);
@@ -37,20 +58,25 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    // One line, the way a user can act on it, and the conventional usage-error status. Every
-    // message is printed through printable(): file names, profile keys and values and metadata
-    // in it come from outside and may hold newlines or terminal escape sequences.
-    fmt::print(stderr, "nelf: {} (see nelf --help)\n", nelf::printable(e.what()));
+    // One line, the way a user can act on it, and the conventional usage-error status.
+    print_error_line(fmt::format("{} (see nelf --help)", e.what()));
     return 2;
   } catch (const nelf::ProfileError& e) {
-    fmt::print(stderr, "nelf: {}\n", nelf::printable(e.what()));
+    print_error_line(e.what());
     return 2;
   } catch (const nelf::app::UserError& e) {
-    fmt::print(stderr, "nelf: {}\n", nelf::printable(e.what()));
+    print_error_line(e.what());
     return e.status();
+  } catch (const std::system_error& e) {
+    // fmt::print reports a failed write this way (EPIPE when stdout is a closed pipe).
+    if (e.code() == std::errc::broken_pipe) return broken_pipe_status;
+    print_error_line(fmt::format("error: {}", e.what()));
+    return 1;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "nelf: error: {}\n", nelf::printable(e.what()));
+    print_error_line(fmt::format("error: {}", e.what()));
     return 1;
   }
+  // What is still buffered for stdout: a reader that left early is the same quiet end.
+  if (std::fflush(stdout) != 0 && errno == EPIPE) return broken_pipe_status;
   return 0;
 }

@@ -106,7 +106,7 @@ class TemporaryFile {
   fs::path path_;
 };
 
-// Holds back SIGINT, SIGTERM and SIGHUP of the calling thread while the file is written and renamed,
+// Holds back SIGINT, SIGTERM, SIGHUP and SIGQUIT of the calling thread while the file is written and renamed,
 // so that Ctrl-C cannot leave a temporary file behind; a pending signal is delivered when the block
 // ends, after the file is complete (or removed). Lasts a fraction of a second for a frame.
 class DeferredTermination {
@@ -117,6 +117,7 @@ class DeferredTermination {
     sigaddset(&block, SIGINT);
     sigaddset(&block, SIGTERM);
     sigaddset(&block, SIGHUP);
+    sigaddset(&block, SIGQUIT);
     active_ = ::pthread_sigmask(SIG_BLOCK, &block, &previous_) == 0;
   }
   ~DeferredTermination() {
@@ -143,7 +144,8 @@ void check_image_writable(const fs::path& path, const ImageWriteOptions& options
   if (options.bits == 16 && (*format == FileFormat::jpeg || *format == FileFormat::exr))
     throw ImageWriteError(fmt::format("cannot write {}: 16-bit output needs .png or .tif", path.string()));
   std::error_code ec;
-  if (!options.overwrite && fs::exists(path, ec))
+  // symlink_status: a dangling symlink is an existing name too, replaced only with `overwrite`.
+  if (!options.overwrite && fs::exists(fs::symlink_status(path, ec)))
     throw ImageWriteError(fmt::format("{} exists; pass -y to overwrite", path.string()));
   if (fs::is_directory(path, ec))
     throw ImageWriteError(fmt::format("cannot write {}: it is a directory", path.string()));

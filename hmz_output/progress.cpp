@@ -53,21 +53,23 @@ void ProgressReporter::frame_done(Clock::time_point now) {
       bar = "[" + std::string(static_cast<std::size_t>(filled), '#') +
             std::string(static_cast<std::size_t>(width - filled), '.') + "] ";
     }
-    fmt::print(out_, "\r{}{}\x1b[K", bar, status(now));
+    print(fmt::format("\r{}{}\x1b[K", bar, status(now)));
     printed_bar_ = true;
   } else {
-    fmt::print(out_, "nelf: {}\n", status(now));
+    print(fmt::format("nelf: {}\n", status(now)));
   }
-  std::fflush(out_);
 }
 
 void ProgressReporter::finish(const std::string& summary, Clock::time_point now) {
   if (style_ == Style::quiet) return;
-  if (printed_bar_) fmt::print(out_, "\r\x1b[K");
+  if (printed_bar_) print("\r\x1b[K");
   const double elapsed = std::chrono::duration<double>(now - start_).count();
-  fmt::print(out_, "nelf: {} ({} frames in {}, {:.1f} fps)\n", summary, frames_, clock_time(elapsed),
-             elapsed > 0 ? frames_ / elapsed : 0.0);
-  std::fflush(out_);
+  print(fmt::format("nelf: {} ({} frames in {}, {:.1f} fps)\n", summary, frames_, clock_time(elapsed),
+                    elapsed > 0 ? frames_ / elapsed : 0.0));
+}
+
+void ProgressReporter::print(const std::string& text) {
+  if (std::fwrite(text.data(), 1, text.size(), out_) != text.size() || std::fflush(out_) != 0) style_ = Style::quiet;
 }
 
 }  // namespace nelf

@@ -1,6 +1,7 @@
 #pragma once
 // Progress of a conversion on stderr: a live bar (percent, fps, ETA) on a terminal, a plain line
-// every few seconds otherwise (logs, pipes), nothing when quiet.
+// every few seconds otherwise (logs, pipes), nothing when quiet. Progress is only a diagnostic: when
+// it cannot be written (stderr a closed pipe, a terminal that is gone) it stops, the job goes on.
 #include <chrono>
 #include <cstdio>
 #include <optional>
@@ -28,6 +29,9 @@ class ProgressReporter {
   std::string status(Clock::time_point now) const;
 
  private:
+  // Writes `text`; a failed write turns the reporter quiet instead of failing the job.
+  void print(const std::string& text);
+
   std::optional<long> total_;
   Style style_;
   std::FILE* out_;

@@ -275,7 +275,8 @@ VideoEncoder::VideoEncoder(const std::filesystem::path& output, int width, int h
   State& s = *state_;
   s.output = output;
   std::error_code ec;
-  if (std::filesystem::exists(output, ec) && !settings.overwrite)
+  // symlink_status: a dangling symlink is an existing name too (finish() would replace it).
+  if (std::filesystem::exists(std::filesystem::symlink_status(output, ec)) && !settings.overwrite)
     throw std::runtime_error(fmt::format("{}: already exists; pass -y to overwrite", output.string()));
   const AVOutputFormat* format = av_guess_format(nullptr, output.filename().c_str(), nullptr);
   if (!format)

@@ -265,6 +265,41 @@ TEST(ConvertStills, BadOutputs) {
   }
 }
 
+// An output that is one of the inputs is refused before any work, -y or not: one line, status 2,
+// the input byte for byte as it was (by name, another spelling, a symlink or hard link, the --right
+// view). A dangling symlink at the output name needs -y like any existing name.
+TEST(ConvertStills, OutputOntoAnInputIsRefused) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  write_test_image(dir / "in.png", sbs_image(320, 180), 3);
+  write_test_image(dir / "left.png", view_image(160, 180, true), 3);
+  write_test_image(dir / "right.png", view_image(160, 180, false), 3);
+  std::filesystem::create_symlink(dir / "in.png", dir / "link.png");
+  std::filesystem::create_hard_link(dir / "in.png", dir / "hard.png");
+  std::filesystem::create_symlink(dir / "missing.png", dir / "dangling.png");
+  const std::string in_bytes = test::read_file(dir / "in.png"), right_bytes = test::read_file(dir / "right.png");
+  const std::string in = "convert " + q(dir / "in.png") + " ";
+  const std::string tail = " --layout sbs --profile " + q(profile);
+  const std::string same = "the output is the same file as the input";
+  for (const std::string overwrite : {"", " -y"}) {
+    SCOPED_TRACE(overwrite);
+    expect_clean_failure(dir, in + q(dir / "in.png") + tail + overwrite, 2, same);
+    expect_clean_failure(dir, in + q(dir.path().string() + "/./in.png") + tail + overwrite, 2, same);
+    expect_clean_failure(dir, in + q(dir / "link.png") + tail + overwrite, 2, same);
+    expect_clean_failure(dir, in + q(dir / "hard.png") + tail + overwrite, 2, same);
+    expect_clean_failure(dir,
+                         "convert " + q(dir / "left.png") + " --right " + q(dir / "right.png") + " " +
+                             q(dir / "right.png") + " --profile " + q(profile) + overwrite,
+                         2, "the same file as the --right view");
+    EXPECT_EQ(test::read_file(dir / "in.png"), in_bytes);
+    EXPECT_EQ(test::read_file(dir / "right.png"), right_bytes);
+    EXPECT_TRUE(std::filesystem::is_symlink(dir / "link.png"));
+  }
+  expect_clean_failure(dir, in + q(dir / "dangling.png") + tail, 1, "dangling.png exists; pass -y to overwrite");
+  EXPECT_TRUE(std::filesystem::is_symlink(dir / "dangling.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "missing.png"));
+}
+
 TEST(ConvertStills, BadArgumentsExitTwoBeforeAnyWork) {
   TempDir dir;
   write_test_image(dir / "in.png", sbs_image(32, 18), 3);

@@ -449,6 +449,67 @@ TEST(ConvertVideo, BadOutputsAndArguments) {
   EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"in.mkv", "small.toml", "taken.mkv"}));
 }
 
+// An output that is one of the inputs is refused before any work, -y or not, in one line with
+// status 2, and the input is left byte for byte as it was (ffmpeg: "Output same as Input"): by the
+// same name, another spelling of it, a symlink or hard link to it, the --right view, or a frame
+// name of an image sequence.
+TEST(ConvertVideo, OutputOntoAnInputIsRefused) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  make_media(dir / "in.mkv", red_blue(320, 180, false, 3));
+  make_media(dir / "right.mkv", red_blue(160, 180, false, 3));
+  std::filesystem::create_directory(dir / "sub");
+  std::filesystem::create_symlink(dir / "in.mkv", dir / "link.mkv");
+  std::filesystem::create_hard_link(dir / "in.mkv", dir / "hard.mkv");
+  // Frame 2 of out_%05d.png is the input under another name.
+  std::filesystem::create_hard_link(dir / "in.mkv", dir / "out_00002.png");
+  const std::string in_bytes = read_file(dir / "in.mkv"), right_bytes = read_file(dir / "right.mkv");
+  const std::string tail = " --quiet --codec ffv1 --profile " + q(profile);
+  const std::string same = "the output is the same file as the input";
+  for (const std::string overwrite : {"", " -y"}) {
+    SCOPED_TRACE(overwrite);
+    const std::string in = "convert " + q(dir / "in.mkv") + " ";
+    expect_clean_failure(dir, in + q(dir / "in.mkv") + tail + overwrite, 2, same);
+    expect_clean_failure(dir, in + q(dir.path().string() + "/./in.mkv") + tail + overwrite, 2, same);
+    expect_clean_failure(dir, in + q(dir / "sub" / ".." / "in.mkv") + tail + overwrite, 2, same);
+    expect_clean_failure(dir, in + q(dir / "link.mkv") + tail + overwrite, 2, same);
+    expect_clean_failure(dir, in + q(dir / "hard.mkv") + tail + overwrite, 2, same);
+    expect_clean_failure(dir, "convert " + q(dir / "link.mkv") + " " + q(dir / "in.mkv") + tail + overwrite, 2, same);
+    expect_clean_failure(dir, in + "--right " + q(dir / "right.mkv") + " " + q(dir / "right.mkv") + tail + overwrite, 2,
+                         "the same file as the --right view");
+    expect_clean_failure(dir, in + q(dir / "out_%05d.png") + tail + overwrite, 2, same);
+    EXPECT_EQ(read_file(dir / "in.mkv"), in_bytes);
+    EXPECT_EQ(read_file(dir / "right.mkv"), right_bytes);
+    EXPECT_TRUE(std::filesystem::is_symlink(dir / "link.mkv"));
+    EXPECT_EQ(std::filesystem::hard_link_count(dir / "in.mkv"), 3u);
+  }
+  // Relative to the working directory: the case of `nelf convert x.mkv ./x.mkv -y`.
+  const auto r = run_command("cd " + q(dir.path()) + " && " + NELF_BINARY + " convert in.mkv ./in.mkv -y" + tail);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err,
+            "nelf: ./in.mkv: the output is the same file as the input in.mkv; choose another output name (-y "
+            "never replaces an input)\n");
+  EXPECT_EQ(read_file(dir / "in.mkv"), in_bytes);
+}
+
+// A dangling symlink at the output name is an existing name: refused without -y (it used to be
+// replaced), as for stills; with -y the link itself is replaced, its target never created.
+TEST(ConvertVideo, DanglingSymlinkOutputNeedsOverwrite) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  make_media(dir / "in.mkv", red_blue(320, 180, false, 3));
+  std::filesystem::create_symlink(dir / "missing.mkv", dir / "out.mkv");
+  const std::string args =
+      "convert " + q(dir / "in.mkv") + " " + q(dir / "out.mkv") + " --quiet --codec ffv1 --profile " + q(profile);
+  expect_clean_failure(dir, args, 1, "out.mkv: already exists; pass -y to overwrite");
+  EXPECT_TRUE(std::filesystem::is_symlink(dir / "out.mkv"));
+  const auto r = run_nelf(args + " -y");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(std::filesystem::is_symlink(dir / "out.mkv"));
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "out.mkv"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "missing.mkv"));
+}
+
 // Ctrl-C in the middle of a long conversion: status 130, one line, and the temporary file that was
 // being written (listed just before the signal) removed.
 TEST(ConvertVideo, InterruptLeavesNothing) {
@@ -489,6 +550,45 @@ TEST(ConvertVideo, TerminateLeavesNothing) {
     EXPECT_NE(r.err.find("nelf: interrupted: no output written\n"), std::string::npos) << r.err;
     EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"small.toml"}));
   }
+}
+
+// A closed terminal (SIGHUP) and SIGQUIT (Ctrl-\\) stop a conversion as Ctrl-C does: status 130,
+// one line, nothing left of the output (SIGHUP used to kill nelf and leave the temporary file;
+// SIGQUIT, which a shell without job control ignores for background commands, went unheard).
+TEST(ConvertVideo, HangupAndQuitLeaveNothing) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  for (const std::string signal : {"HUP", "QUIT"})
+    for (const std::string output : {"out.mkv", "frame_%04d.png"}) {
+      SCOPED_TRACE(signal + " " + output);
+      // The signal once the output is being written (the temporary file, or the first frame).
+      const std::string written = output == "out.mkv" ? ".out.nelf-" : "frame_0001.png";
+      const auto r = run_command(
+          std::string(NELF_BINARY) + " convert synthetic:duration=30,size=320x180 " + q(dir / output) + " --profile " +
+          q(profile) + " & pid=$!; i=0; while [ $i -lt 200 ] && ! ls -A " + q(dir.path()) + " | grep -q " +
+          shell_quote(written) + "; do sleep 0.1; i=$((i+1)); done; ls -A " + q(dir.path()) + "; kill -" + signal +
+          " $pid; (sleep 15; kill -KILL $pid) 2>/dev/null & guard=$!; wait $pid; status=$?; kill $guard; echo status "
+          "$status");
+      if (output == "out.mkv") {
+        EXPECT_NE(r.out.find(".out.nelf-"), std::string::npos) << "no temporary file while converting: " << r.out;
+      } else {
+        EXPECT_NE(r.out.find("frame_0001.png"), std::string::npos) << "no frame written before the signal: " << r.out;
+      }
+      EXPECT_NE(r.out.find("status 130\n"), std::string::npos) << r.out << r.err;
+      EXPECT_NE(r.err.find("nelf: interrupted: no output written\n"), std::string::npos) << r.err;
+      EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"small.toml"}));
+    }
+}
+
+// Under nohup (SIGHUP ignored when nelf starts) a closed terminal does not stop the conversion.
+TEST(ConvertVideo, IgnoredHangupKeepsConverting) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  const auto r = run_command("trap '' HUP; " + std::string(NELF_BINARY) + " convert synthetic:duration=3,size=160x90 " +
+                             q(dir / "out.mkv") + " --quiet --codec ffv1 --profile " + q(profile) +
+                             " & pid=$!; sleep 1; kill -HUP $pid; wait $pid; echo status $?");
+  EXPECT_EQ(r.out, "status 0\n") << r.err;
+  EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"out.mkv", "small.toml"}));
 }
 
 // A full disk, made real with a file size limit: writes past `ulimit -f` fail with EFBIG exactly as

@@ -214,6 +214,23 @@ TEST(SimulateCli, UnwritableOutput) {
   EXPECT_EQ(files, 2);  // still.png and small.toml
 }
 
+// No output of simulate replaces its input (-o, --ideal, --sweep or the heatmap beside it): refused
+// up front with status 2, the still byte for byte as it was. simulate always replaces its outputs, so
+// `-o still.png` used to write the retinal image over the still.
+TEST(SimulateCli, OutputOntoTheInputIsRefused) {
+  Fixture f;
+  const std::string bytes = read_file(f.still);
+  const std::string still = shell_quote(f.still.string());
+  const std::string head = "simulate " + still + " --profile " + shell_quote(f.profile.string());
+  for (const std::string& args :
+       {" -o " + still, " -o " + shell_quote(f.retina.string()) + " --ideal " + still,
+        " -o " + shell_quote(f.retina.string()) + " --sweep " + shell_quote((f.dir / "still.csv").string())}) {
+    SCOPED_TRACE(args);
+    expect_clean_failure(f.dir, head + args, 2, "the output is the same file as the input");
+    EXPECT_EQ(read_file(f.still), bytes);
+  }
+}
+
 TEST(SimulateCli, StockProfileIsRejected) {
   Fixture f;
   const CommandResult r = run_nelf("simulate " + shell_quote(f.still.string()) + " --profile hmz-t1-stock -o " +

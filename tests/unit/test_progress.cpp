@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <thread>
 
@@ -27,6 +30,26 @@ TEST(Progress, PlainLinesEveryFewSecondsWithPercentAndEta) {
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2) << text;  // at 5 s and 10 s
   EXPECT_NE(text.find("50% 50/100 frames, 5.0 fps, ETA 0:10"), std::string::npos) << text;
   std::fclose(f);
+}
+
+// Progress into a pipe nobody reads (stderr into a pager that quit) is dropped: the conversion goes
+// on instead of failing on a diagnostic. (nelf ignores SIGPIPE, so the write fails with EPIPE.)
+TEST(Progress, AClosedPipeEndsTheProgressNotTheJob) {
+  const auto previous = std::signal(SIGPIPE, SIG_IGN);
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  ::close(fds[0]);
+  std::FILE* f = ::fdopen(fds[1], "w");
+  ASSERT_NE(f, nullptr);
+  const auto t0 = ProgressReporter::Clock::now();
+  ProgressReporter p(100, ProgressReporter::Style::lines, f, t0);
+  EXPECT_NO_THROW({
+    for (int i = 1; i <= 50; ++i) p.frame_done(t0 + std::chrono::milliseconds(200 * i));
+    p.finish("wrote out.mkv", t0 + std::chrono::seconds(11));
+  });
+  EXPECT_EQ(p.frames(), 50);
+  std::fclose(f);
+  std::signal(SIGPIPE, previous);
 }
 
 TEST(Progress, QuietPrintsNothing) {
