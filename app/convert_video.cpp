@@ -21,6 +21,7 @@ extern "C" {
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
 #include "compositor/composite_table_cache.hpp"
+#include "compositor/gl/egl_context.hpp"
 #include "compositor/gl_compositor.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
@@ -296,6 +297,8 @@ class PackedFrameRenderer {
   bool tables_from_cache(const VideoConvertRequest& r, const CompositeTableCache& cache, double aspect) {
     const CompositeChoice choice = composite_choice();
     if (choice == CompositeChoice::gl || (choice == CompositeChoice::automatic && has_render_node())) return false;
+    // GL would have refused a --gpu (or NELF_GPU) that names no device: so does a cache hit.
+    gl::check_requested_gpu(gl::ContextOptions{r.compositor.gpu});
     return load_tables(r, cache, nullptr, aspect);
   }
   // Both eyes' tables from `cache`, else recorded with `recorder` (when given, and kept in
