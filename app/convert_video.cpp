@@ -27,6 +27,7 @@ extern "C" {
 #include "hmz_output/packing.hpp"
 #include "hmz_output/progress.hpp"
 #include "inputs/bounded_queue.hpp"
+#include "inputs/ffmpeg_input.hpp"
 #include "inputs/ffmpeg_raii.hpp"
 #include "inputs/stereo_frame_source.hpp"
 #include "inputs/synthetic_source.hpp"
@@ -50,15 +51,11 @@ class FrameSink {
 class SourcePacketCarrier {
  public:
   SourcePacketCarrier(const std::string& path, double origin_s, bool allow_network) : origin_s_(origin_s) {
-    AVDictionary* raw_options = nullptr;
-    if (!allow_network) av_dict_set(&raw_options, "protocol_whitelist", "file,pipe", 0);
-    AVFormatContext* raw = nullptr;
-    const std::string url = path.find("://") == std::string::npos ? "file:" + path : path;
-    const int opened = avformat_open_input(&raw, url.c_str(), nullptr, &raw_options);
-    ffmpeg::DictionaryPtr unused(raw_options);
+    network_.allow_network = allow_network;
+    const int opened = ffmpeg::open_input(format_, path, network_);
+    if (!network_.refused_protocol.empty()) throw UserError(ffmpeg::network_refusal(path, network_), 1);
     if (opened < 0)
       throw UserError(fmt::format("{}: cannot reopen for audio: {}", path, ffmpeg::error_string(opened)), 1);
-    format_.reset(raw);
     if (avformat_find_stream_info(format_.get(), nullptr) < 0)
       throw UserError(fmt::format("{}: cannot read stream information", path), 1);
     if (origin_s > format_->start_time / static_cast<double>(AV_TIME_BASE) + 0.001)
@@ -96,6 +93,7 @@ class SourcePacketCarrier {
   }
 
  private:
+  ffmpeg::NetworkGuard network_;  // before `format_`: the context points at it while it lives
   ffmpeg::FormatContextPtr format_;
   ffmpeg::PacketPtr packet_;
   double origin_s_;
