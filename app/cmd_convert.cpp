@@ -223,7 +223,7 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--duration", args->duration, "Video: convert this many seconds");
   cmd->add_option("--frames", args->frames, "Video: convert at most this many frames");
   cmd->add_flag("--no-audio", args->no_audio, "Video: leave the audio out");
-  cmd->add_flag("--quiet", args->quiet, "Video: no progress output");
+  cmd->add_flag("--quiet", args->quiet, "Video: no progress output (warnings are still printed)");
   cmd->add_flag("--strict", args->strict, "Video: a damaged or truncated input is an error");
   cmd->callback([args] { run_convert(*args); });
 }
