@@ -155,16 +155,32 @@ class EncodedFileSink final : public FrameSink {
 };
 
 // frames_%05d.png: one image per frame. Written files are removed again unless finish() is reached.
+// A plain image name (x.png) holds the one frame converted, written only by finish(): the file
+// appears when the conversion succeeded, or not at all.
 class ImageSequenceSink final : public FrameSink {
  public:
-  ImageSequenceSink(const VideoConvertRequest& r) : pattern_(r.output), options_{r.encoder.overwrite, 8} {}
+  ImageSequenceSink(const VideoConvertRequest& r)
+      : pattern_(r.output), single_(!is_image_sequence_pattern(r.output)), options_{r.encoder.overwrite, 8} {}
   ~ImageSequenceSink() override {
     if (finished_) return;
     std::error_code ec;
     for (const auto& f : written_) std::filesystem::remove(f, ec);
   }
   void write(const PackedFrame& frame) override {
-    const std::string name = fmt::sprintf(pattern_, static_cast<int>(written_.size()) + 1);
+    if (single_) {
+      if (single_frame_) throw std::logic_error("a single image output was given a second frame");
+      single_frame_.emplace(frame);
+      return;
+    }
+    write_frame(frame, fmt::sprintf(pattern_, static_cast<int>(written_.size()) + 1));
+  }
+  void finish() override {
+    if (single_ && single_frame_) write_frame(*single_frame_, pattern_);
+    finished_ = true;
+  }
+
+ private:
+  void write_frame(const PackedFrame& frame, const std::string& name) {
     Image image(frame.width, frame.height);
     const std::size_t bpp = bytes_per_pixel(frame.bits);
     float* out = image.data();
@@ -185,10 +201,10 @@ class ImageSequenceSink final : public FrameSink {
     }
     written_.push_back(name);
   }
-  void finish() override { finished_ = true; }
 
- private:
   std::string pattern_;
+  bool single_;
+  std::optional<PackedFrame> single_frame_;
   ImageWriteOptions options_;
   std::vector<std::filesystem::path> written_;
   bool finished_ = false;
@@ -462,7 +478,7 @@ void convert_video(const VideoConvertRequest& r) {
   std::unique_ptr<FrameSink> sink;
   try {
     const auto [width, height] = size_future.get();
-    if (is_image_sequence_pattern(r.output))
+    if (is_image_sequence_pattern(r.output) || is_image_file_name(r.output))
       sink = std::make_unique<ImageSequenceSink>(r);
     else
       sink = std::make_unique<EncodedFileSink>(r, *source, width, height, bits, source->origin_s());

@@ -12,9 +12,11 @@
 namespace nelf::app {
 
 struct VideoConvertRequest {
-  std::string input;   // a media file or `synthetic:[options]`
-  std::string right;   // second input for layout pair
-  std::string output;  // a video file, or an image sequence pattern such as frames_%05d.png
+  std::string input;  // a media file or `synthetic:[options]`
+  std::string right;  // second input for layout pair
+  // A video file, an image sequence pattern such as frames_%05d.png, or one image (x.png: then
+  // max_frames must be 1).
+  std::string output;
   Profile profile;
   Signal signal;
   CompositorOptions compositor;
