@@ -104,6 +104,21 @@ void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
   r.start_s = args.start;
   r.duration_s = args.duration;
   r.max_frames = args.frames;
+  // One image named as such (x.png) is the frame at --start, as `ffmpeg -ss T -i IN -frames:v 1 x.png`
+  // writes it; more frames need a name for each.
+  if (!is_image_sequence_pattern(args.output) && is_image_file_name(args.output)) {
+    const std::filesystem::path out(args.output);
+    const std::string pattern =
+        (out.parent_path() / (out.stem().string() + "_%05d" + out.extension().string())).string();
+    if (args.frames && *args.frames > 1)
+      throw UserError(fmt::format("{} holds one frame; for {} frames name an image sequence such as {}", args.output,
+                                  *args.frames, pattern),
+                      2);
+    if (args.duration)
+      throw UserError(
+          fmt::format("{} holds one frame; for --duration name an image sequence such as {}", args.output, pattern), 2);
+    r.max_frames = 1;
+  }
   r.quiet = args.quiet;
   r.strict = args.strict;
   r.allow_network = args.allow_network;
@@ -235,7 +250,10 @@ void add_convert_command(CLI::App& app) {
   auto* cmd =
       app.add_subcommand("convert", "Convert a stereo image or video (or synthetic:) into what the display needs");
   add_common_options(*cmd, *args);
-  cmd->add_option("output", args->output, "Output image (.png, .tif, .exr, .jpg)")->required();
+  cmd->add_option("output", args->output,
+                  "Output: a video file, an image (.png, .tif, .exr, .jpg; of a video: the frame at --start) or an "
+                  "image sequence pattern (frames_%05d.png)")
+      ->required();
   cmd->add_option("--bits", args->bits, "Bits per channel of the output file: 8, or 16 for .png/.tif")
       ->capture_default_str();
   cmd->add_flag("-y,--overwrite", args->overwrite, "Replace the output file if it exists");
@@ -245,7 +263,7 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--duration", args->duration, "Video: convert this many seconds");
   cmd->add_option("--frames", args->frames, "Video: convert at most this many frames");
   cmd->add_flag("--no-audio", args->no_audio, "Video: leave the audio out");
-  cmd->add_flag("--quiet", args->quiet, "Video: no progress output");
+  cmd->add_flag("--quiet", args->quiet, "Video: no progress output (warnings are still printed)");
   cmd->add_flag("--strict", args->strict, "Video: a damaged or truncated input is an error");
   cmd->callback([args] { run_convert(*args); });
 }

@@ -82,7 +82,7 @@ void add_play_command(CLI::App& app) {
   cmd->add_option("--monitor", args->monitor, "fullscreen: the monitor (default: the one named like HMZ)");
   cmd->add_option("--connector", args->connector, "kms: the connector, e.g. HDMI-A-1 (default: the first with 3D)");
   cmd->add_flag("--no-audio", args->no_audio, "Play without sound (the system clock paces the video)");
-  cmd->add_flag("--quiet", args->quiet, "Only the summary line at exit");
+  cmd->add_flag("--quiet", args->quiet, "Only warnings and the summary line at exit");
   cmd->add_option("--log-frames", args->log_frames,
                   "Diagnostics: write a CSV line per presented refresh (pts, clock, audio clock, counters)");
   cmd->callback([args] { run_play(*args); });

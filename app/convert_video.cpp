@@ -22,11 +22,13 @@ extern "C" {
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
 #include "compositor/composite_table_cache.hpp"
+#include "compositor/gl/egl_context.hpp"
 #include "compositor/gl_compositor.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
 #include "hmz_output/progress.hpp"
 #include "inputs/bounded_queue.hpp"
+#include "inputs/ffmpeg_input.hpp"
 #include "inputs/ffmpeg_raii.hpp"
 #include "inputs/stereo_frame_source.hpp"
 #include "inputs/synthetic_source.hpp"
@@ -50,15 +52,11 @@ class FrameSink {
 class SourcePacketCarrier {
  public:
   SourcePacketCarrier(const std::string& path, double origin_s, bool allow_network) : origin_s_(origin_s) {
-    AVDictionary* raw_options = nullptr;
-    if (!allow_network) av_dict_set(&raw_options, "protocol_whitelist", "file,pipe", 0);
-    AVFormatContext* raw = nullptr;
-    const std::string url = path.find("://") == std::string::npos ? "file:" + path : path;
-    const int opened = avformat_open_input(&raw, url.c_str(), nullptr, &raw_options);
-    ffmpeg::DictionaryPtr unused(raw_options);
+    network_.allow_network = allow_network;
+    const int opened = ffmpeg::open_input(format_, path, network_);
+    if (!network_.refused_protocol.empty()) throw UserError(ffmpeg::network_refusal(path, network_), 1);
     if (opened < 0)
       throw UserError(fmt::format("{}: cannot reopen for audio: {}", path, ffmpeg::error_string(opened)), 1);
-    format_.reset(raw);
     if (avformat_find_stream_info(format_.get(), nullptr) < 0)
       throw UserError(fmt::format("{}: cannot read stream information", path), 1);
     if (origin_s > format_->start_time / static_cast<double>(AV_TIME_BASE) + 0.001)
@@ -99,6 +97,7 @@ class SourcePacketCarrier {
   }
 
  private:
+  ffmpeg::NetworkGuard network_;  // before `format_`: the context points at it while it lives
   ffmpeg::FormatContextPtr format_;
   ffmpeg::PacketPtr packet_;
   double origin_s_;
@@ -160,17 +159,35 @@ class EncodedFileSink final : public FrameSink {
 };
 
 // frames_%05d.png: one image per frame. Written files are removed again unless finish() is reached.
+// A plain image name (x.png) holds the one frame converted, written only by finish(): the file
+// appears when the conversion succeeded, or not at all.
 class ImageSequenceSink final : public FrameSink {
  public:
   ImageSequenceSink(const VideoConvertRequest& r)
-      : pattern_(r.output), inputs_(r.inputs), options_{r.encoder.overwrite, 8} {}
+      : pattern_(r.output),
+        inputs_(r.inputs),
+        single_(!is_image_sequence_pattern(r.output)),
+        options_{r.encoder.overwrite, 8} {}
   ~ImageSequenceSink() override {
     if (finished_) return;
     std::error_code ec;
     for (const auto& f : written_) std::filesystem::remove(f, ec);
   }
   void write(const PackedFrame& frame) override {
-    const std::string name = fmt::sprintf(pattern_, static_cast<int>(written_.size()) + 1);
+    if (single_) {
+      if (single_frame_) throw std::logic_error("a single image output was given a second frame");
+      single_frame_.emplace(frame);
+      return;
+    }
+    write_frame(frame, fmt::sprintf(pattern_, static_cast<int>(written_.size()) + 1));
+  }
+  void finish() override {
+    if (single_ && single_frame_) write_frame(*single_frame_, pattern_);
+    finished_ = true;
+  }
+
+ private:
+  void write_frame(const PackedFrame& frame, const std::string& name) {
     // Any frame's name may be an input (out_%05d.png expanding to an input's name, or a link to it).
     inputs_.refuse_as_output(name);
     Image image(frame.width, frame.height);
@@ -193,11 +210,11 @@ class ImageSequenceSink final : public FrameSink {
     }
     written_.push_back(name);
   }
-  void finish() override { finished_ = true; }
 
- private:
   std::string pattern_;
   const InputFiles& inputs_;
+  bool single_;
+  std::optional<PackedFrame> single_frame_;
   ImageWriteOptions options_;
   std::vector<std::filesystem::path> written_;
   bool finished_ = false;
@@ -304,6 +321,8 @@ class PackedFrameRenderer {
   bool tables_from_cache(const VideoConvertRequest& r, const CompositeTableCache& cache, double aspect) {
     const CompositeChoice choice = composite_choice();
     if (choice == CompositeChoice::gl || (choice == CompositeChoice::automatic && has_render_node())) return false;
+    // GL would have refused a --gpu (or NELF_GPU) that names no device: so does a cache hit.
+    gl::check_requested_gpu(gl::ContextOptions{r.compositor.gpu});
     return load_tables(r, cache, nullptr, aspect);
   }
   // Both eyes' tables from `cache`, else recorded with `recorder` (when given, and kept in
@@ -470,7 +489,7 @@ void convert_video(const VideoConvertRequest& r) {
   std::unique_ptr<FrameSink> sink;
   try {
     const auto [width, height] = size_future.get();
-    if (is_image_sequence_pattern(r.output))
+    if (is_image_sequence_pattern(r.output) || is_image_file_name(r.output))
       sink = std::make_unique<ImageSequenceSink>(r);
     else
       sink = std::make_unique<EncodedFileSink>(r, *source, width, height, bits, source->origin_s());

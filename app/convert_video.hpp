@@ -14,10 +14,12 @@
 namespace nelf::app {
 
 struct VideoConvertRequest {
-  std::string input;   // a media file or `synthetic:[options]`
-  std::string right;   // second input for layout pair
-  std::string output;  // a video file, or an image sequence pattern such as frames_%05d.png
-  InputFiles inputs;   // what no output file may replace (each frame of a sequence is checked)
+  std::string input;  // a media file or `synthetic:[options]`
+  std::string right;  // second input for layout pair
+  // A video file, an image sequence pattern such as frames_%05d.png, or one image (x.png: then
+  // max_frames must be 1).
+  std::string output;
+  InputFiles inputs;  // what no output file may replace (each frame of a sequence is checked)
   Profile profile;
   Signal signal;
   CompositorOptions compositor;

@@ -2,11 +2,13 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <string>
 #include <system_error>
 
+#include "app/cli_suggestions.hpp"
 #include "app/commands.hpp"
 #include "compositor/profile.hpp"
 #include "inputs/printable.hpp"
@@ -32,6 +34,22 @@ void print_error_line(const std::string& message) {
   std::fwrite(line.data(), 1, line.size(), stderr);
 }
 
+// CLI11 reads "nan" and "inf" as numbers; no option of nelf means either (a time, a diameter).
+// Applied here to every floating-point option of every command, so that a new one cannot miss it.
+void refuse_non_finite_numbers(CLI::App& app) {
+  const CLI::Validator finite(
+      [](std::string& text) -> std::string {
+        double value = 0;
+        if (CLI::detail::lexical_cast(text, value) && !std::isfinite(value))
+          return "must be a finite number, got " + text;
+        return {};
+      },
+      "");
+  for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; }))
+    for (CLI::Option* option : command->get_options())
+      if (option->get_type_name() == "FLOAT") option->check(finite);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -48,6 +66,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", fmt::format("nelf {}", NELF_VERSION));
   app.require_subcommand(1);
   for (auto add : registrars) add(app);
+  refuse_non_finite_numbers(app);
 
   try {
     app.parse(argc, argv);
@@ -58,8 +77,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    // One line, the way a user can act on it, and the conventional usage-error status.
-    print_error_line(fmt::format("{} (see nelf --help)", e.what()));
+    // One line, the way a user can act on it, and the conventional usage-error status. A mistyped
+    // command or option is named with the nearest one; CLI11's wording does not name it.
+    if (const auto unknown = nelf::app::unknown_argument_message(app, argc, argv))
+      print_error_line(*unknown);
+    else
+      print_error_line(fmt::format("{} (see nelf --help)", e.what()));
     return 2;
   } catch (const nelf::ProfileError& e) {
     print_error_line(e.what());

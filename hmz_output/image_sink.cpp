@@ -133,6 +133,8 @@ class DeferredTermination {
 
 }  // namespace
 
+bool is_image_file_name(const fs::path& path) { return format_for(path).has_value(); }
+
 void check_image_writable(const fs::path& path, const ImageWriteOptions& options) {
   const auto format = format_for(path);
   if (!format)

@@ -22,6 +22,9 @@ struct ImageWriteOptions {
   int bits = 8;            // 8 or 16 per channel for PNG and TIFF; EXR is always half float, JPEG 8
 };
 
+// True when `path` ends in an extension write_image_file writes (.png, .tif, .tiff, .exr, .jpg, .jpeg).
+bool is_image_file_name(const std::filesystem::path& path);
+
 // Throws ImageWriteError unless `path` could be written with `options`: unknown extension, bits
 // not 8/16, 16 bits for a format that cannot hold them, existing file without `overwrite`, missing
 // directory. Cheap; the CLI calls it before doing any work.

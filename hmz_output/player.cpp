@@ -616,7 +616,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   try {
     image_library::preload();
   } catch (const image_library::ImageLibraryError& e) {
-    if (!options.quiet) std::fprintf(stderr, "nelf: warning: %s\n", e.what());
+    std::fprintf(stderr, "nelf: warning: %s\n", e.what());
   }
   display.context()->make_current();
   PackedRenderer renderer(display, options);

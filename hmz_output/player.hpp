@@ -28,7 +28,7 @@ struct PlayerOptions {
   bool allow_network = false;  // for reopening the input's audio
   int audio_rate = 48000;
   std::string log_frames;  // CSV of every refresh (diagnostics); "" = none
-  bool quiet = false;      // no "playing …" / audio status lines on stderr
+  bool quiet = false;      // no "playing …" / audio status lines on stderr (warnings still are)
   // Each key's change said on screen for 2 s. Off (tests): while a message shows, frames are
   // composited with GL (the text is drawn there), so without them the CPU path and its frames
   // composited ahead are seen right after a key.

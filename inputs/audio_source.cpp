@@ -12,6 +12,7 @@ extern "C" {
 #include <libswresample/swresample.h>
 }
 
+#include "inputs/ffmpeg_input.hpp"
 #include "inputs/ffmpeg_raii.hpp"
 
 namespace nelf {
@@ -23,13 +24,12 @@ struct SwrContextDeleter {
 };
 using SwrContextPtr = std::unique_ptr<SwrContext, SwrContextDeleter>;
 
-bool is_url(const std::string& path) { return path.find("://") != std::string::npos || path.rfind("pipe:", 0) == 0; }
-
 }  // namespace
 
 struct AudioSource::Impl {
   std::string path;
   AudioSourceOptions options;
+  ffmpeg::NetworkGuard network;  // before `format`: the context points at it while it lives
   ffmpeg::FormatContextPtr format;
   ffmpeg::CodecContextPtr codec;
   ffmpeg::PacketPtr packet{av_packet_alloc()};
@@ -48,17 +48,14 @@ struct AudioSource::Impl {
     path = p;
     options = o;
     if (options.sample_rate <= 0) fail("the audio sample rate must be > 0");
-    const std::string url = is_url(path) ? path : "file:" + path;
-    AVDictionary* raw_options = nullptr;
     // The same rule as VideoSource (DESIGN.md §11): no network unless asked for.
-    if (!options.allow_network) av_dict_set(&raw_options, "protocol_whitelist", "file,pipe", 0);
-    AVFormatContext* raw = nullptr;
-    const int opened = avformat_open_input(&raw, url.c_str(), nullptr, &raw_options);
-    ffmpeg::DictionaryPtr unused(raw_options);
+    network.allow_network = options.allow_network;
+    const int opened = ffmpeg::open_input(format, path, network);
+    if (!network.refused_protocol.empty()) throw AudioError(ffmpeg::network_refusal(path, network));
     if (opened < 0) fail(fmt::format("cannot open: {}", ffmpeg::error_string(opened)));
-    format.reset(raw);
-    if (const int found = avformat_find_stream_info(format.get(), nullptr); found < 0)
-      fail(fmt::format("not a readable media file: {}", ffmpeg::error_string(found)));
+    const int found = avformat_find_stream_info(format.get(), nullptr);
+    if (!network.refused_protocol.empty()) throw AudioError(ffmpeg::network_refusal(path, network));
+    if (found < 0) fail(fmt::format("not a readable media file: {}", ffmpeg::error_string(found)));
     const AVCodec* decoder = nullptr;
     const int best = av_find_best_stream(format.get(), AVMEDIA_TYPE_AUDIO, -1, -1, &decoder, 0);
     if (best == AVERROR_STREAM_NOT_FOUND) fail("no audio stream");

@@ -106,7 +106,8 @@ class FileFrameSource final : public StereoFrameSource {
     } catch (const std::exception& e) {
       throw UserError(fmt::format("{}: {}", r.input, e.what()), 1);
     }
-    if (!decision_.warning.empty() && !r.quiet) fmt::print(stderr, "nelf: warning: {}\n", printable(decision_.warning));
+    // --quiet hides progress and descriptions, never a warning (as ffmpeg -nostats or mpv --quiet).
+    if (!decision_.warning.empty()) fmt::print(stderr, "nelf: warning: {}\n", printable(decision_.warning));
     if (decision_.layout == StereoLayout::pair) {
       if (r.right.empty()) throw UserError("layout pair needs the right view as a second file (--right FILE)", 2);
       right_.emplace(open(r.right, r));

@@ -42,7 +42,7 @@ struct StereoSourceRequest {
   std::optional<StereoLayout> layout;  // nullopt: detect
   bool swap_eyes = false;
   std::optional<double> start_s;                // start here (seconds from the start of the input)
-  bool quiet = false;                           // no line describing the input, no layout warning
+  bool quiet = false;                           // no line describing the input (warnings are printed all the same)
   bool allow_network = false;                   // FFmpeg protocols beyond file and pipe
   ViewBlockChooser view_block;                  // empty: whole views; else as reduce_views() from the first frame
   std::int64_t max_pixels = kDefaultMaxPixels;  // --max-pixels: larger frames are refused undecoded

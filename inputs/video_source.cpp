@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string_view>
 
+#include "inputs/ffmpeg_input.hpp"
 #include "inputs/ffmpeg_raii.hpp"
 #include "inputs/yuv_block_means.hpp"
 
@@ -67,8 +68,6 @@ Image VideoFrame::to_image() const {
 namespace {
 
 using namespace nelf::ffmpeg;
-
-bool is_url(const std::string& path) { return path.find("://") != std::string::npos || path.rfind("pipe:", 0) == 0; }
 
 double rational_or_zero(AVRational r) { return r.num > 0 && r.den > 0 ? av_q2d(r) : 0.0; }
 
@@ -212,6 +211,7 @@ void copy_rotated(const uint8_t* src, int src_stride_bytes, int width, int heigh
 struct VideoSource::Impl {
   VideoInfo info;
   VideoSourceOptions options;
+  NetworkGuard network;  // before `format`: the context points at it while it lives
   FormatContextPtr format;
   CodecContextPtr codec;
   AVStream* stream = nullptr;
@@ -251,30 +251,22 @@ struct VideoSource::Impl {
 
   void open(const std::string& path) {
     info.path = path;
-    std::string url = path;
     if (!is_url(path)) {
       std::error_code ec;
       const auto status = std::filesystem::status(path, ec);
       if (!std::filesystem::exists(status)) fail("no such file");
       if (std::filesystem::is_directory(status)) fail("is a directory, not a media file");
-      // "file:" keeps a colon in a local name from being read as a protocol.
-      url = "file:" + path;
     }
 
-    AVDictionary* raw_options = nullptr;
     // Playlists (HLS, concat, …) can otherwise make FFmpeg fetch URLs (DESIGN.md §11).
-    if (!options.allow_network) av_dict_set(&raw_options, "protocol_whitelist", "file,pipe", 0);
-    AVFormatContext* raw_format = nullptr;
-    const int opened = avformat_open_input(&raw_format, url.c_str(), nullptr, &raw_options);
-    DictionaryPtr unused_options(raw_options);
+    network.allow_network = options.allow_network;
+    const int opened = open_input(format, path, network);
+    if (!network.refused_protocol.empty()) throw VideoError(network_refusal(path, network));
     if (opened < 0) {
       if (opened == AVERROR_INVALIDDATA) fail("not a media file FFmpeg can read");
       if (opened == AVERROR(EACCES)) fail("permission denied");
-      if (!options.allow_network && is_url(path) && path.rfind("pipe:", 0) != 0)
-        fail(fmt::format("cannot open ({}); network access needs --allow-network", error_string(opened)));
       fail(fmt::format("cannot open: {}", error_string(opened)));
     }
-    format.reset(raw_format);
     info.container = format->iformat->name;
     // FFmpeg opens any text file as "tty" (ANSI art) video; a text file is never meant as content.
     if (info.container == "tty") fail("not a media file (it looks like text)");
@@ -293,6 +285,8 @@ struct VideoSource::Impl {
     for (AVDictionary*& o : probe_options) av_dict_set(&o, "max_pixels", max_pixels.c_str(), 0);
     const int found = avformat_find_stream_info(format.get(), probe_options.empty() ? nullptr : probe_options.data());
     for (AVDictionary*& o : probe_options) av_dict_free(&o);
+    // Some demuxers open what a playlist names only when probing the streams.
+    if (!network.refused_protocol.empty()) throw VideoError(network_refusal(path, network));
     if (found < 0) fail(fmt::format("not a readable media file: {}", error_string(found)));
 
     for (unsigned i = 0; i < format->nb_streams; ++i)

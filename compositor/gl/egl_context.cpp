@@ -146,6 +146,11 @@ std::string device_name(EGLDeviceEXT device) {
   return "hardware";
 }
 
+GlError gpu_not_listed(int gpu, std::size_t devices) {
+  return GlError(fmt::format("GPU {} requested but EGL lists {} device(s) (indices 0..{})", gpu, devices,
+                             static_cast<int>(devices) - 1));
+}
+
 }  // namespace
 
 std::optional<int> requested_gpu(const ContextOptions& options) {
@@ -160,6 +165,13 @@ std::optional<int> requested_gpu(const ContextOptions& options) {
   if (*end != '\0' || value < 0 || value > 1000)
     throw GlError(fmt::format("NELF_GPU must be a device index >= 0, got '{}'", env));
   return static_cast<int>(value);
+}
+
+void check_requested_gpu(const ContextOptions& options) {
+  const std::optional<int> gpu = requested_gpu(options);
+  if (!gpu) return;
+  const std::size_t devices = query_devices().size();
+  if (static_cast<std::size_t>(*gpu) >= devices) throw gpu_not_listed(*gpu, devices);
 }
 
 EglContext::EglContext(const ContextOptions& options) {
@@ -185,9 +197,7 @@ EglContext::EglContext(const ContextOptions& options) {
 
   if (gpu) {
     // An explicit choice is honoured or refused, never silently replaced by another device.
-    if (static_cast<std::size_t>(*gpu) >= devices.size())
-      throw GlError(fmt::format("GPU {} requested but EGL lists {} device(s) (indices 0..{})", *gpu, devices.size(),
-                                static_cast<int>(devices.size()) - 1));
+    if (static_cast<std::size_t>(*gpu) >= devices.size()) throw gpu_not_listed(*gpu, devices.size());
     if (!try_device(static_cast<std::size_t>(*gpu)))
       throw GlError(fmt::format("GPU {} requested but unusable: {}", *gpu, tried.back()));
   } else {

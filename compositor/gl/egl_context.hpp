@@ -52,4 +52,9 @@ class EglContext final : public Context {
 // "gpu" from the options, else NELF_GPU (validated: a non-negative integer), else nothing.
 std::optional<int> requested_gpu(const ContextOptions& options);
 
+// Throws the GlError EglContext throws for a requested device (requested_gpu) that EGL does not
+// list, without creating a context: for work that may not need GL at all (composite tables from
+// the cache), so that a wrong --gpu is reported whether or not GL is started.
+void check_requested_gpu(const ContextOptions& options);
+
 }  // namespace nelf::gl

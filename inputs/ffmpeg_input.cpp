@@ -1,0 +1,73 @@
+#include "inputs/ffmpeg_input.hpp"
+
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace nelf::ffmpeg {
+namespace {
+
+using IoOpen = int (*)(AVFormatContext*, AVIOContext**, const char*, int, AVDictionary**);
+
+// FFmpeg's own io_open (not public API): what a fresh context starts with.
+IoOpen default_io_open() {
+  static const IoOpen open = [] {
+    AVFormatContext* context = avformat_alloc_context();
+    const IoOpen found = context != nullptr ? context->io_open : nullptr;
+    avformat_free_context(context);
+    return found;
+  }();
+  return open;
+}
+
+bool is_local_protocol(const char* protocol) {
+  return protocol != nullptr && (std::strcmp(protocol, "file") == 0 || std::strcmp(protocol, "pipe") == 0);
+}
+
+// Every URL a demuxer opens comes through here (the input, then HLS segments, concat entries, …).
+// FFmpeg's protocol_whitelist refuses them too, but only as "Invalid data" or "Invalid argument"
+// for a playlist: this records which protocol was refused, so the user is told what to pass.
+int guarded_io_open(AVFormatContext* context, AVIOContext** pb, const char* url, int flags, AVDictionary** options) {
+  // A nested demuxer's context may have copied io_open but not opaque: the whitelist still holds.
+  auto* guard = static_cast<NetworkGuard*>(context->opaque);
+  if (guard != nullptr && !guard->allow_network) {
+    const char* protocol = avio_find_protocol_name(url);
+    if (!is_local_protocol(protocol)) {
+      if (guard->refused_protocol.empty()) guard->refused_protocol = protocol != nullptr ? protocol : "unknown";
+      return AVERROR(EPERM);
+    }
+  }
+  return default_io_open()(context, pb, url, flags, options);
+}
+
+}  // namespace
+
+bool is_url(const std::string& path) { return path.find("://") != std::string::npos || path.rfind("pipe:", 0) == 0; }
+
+int open_input(FormatContextPtr& format, const std::string& path, NetworkGuard& guard) {
+  const std::string url = is_url(path) ? path : "file:" + path;
+  AVFormatContext* raw = avformat_alloc_context();
+  if (raw == nullptr) return AVERROR(ENOMEM);
+  AVDictionary* raw_options = nullptr;
+  if (!guard.allow_network) {
+    if (default_io_open() == nullptr) {
+      avformat_free_context(raw);
+      return AVERROR_BUG;
+    }
+    raw->opaque = &guard;
+    raw->io_open = guarded_io_open;
+    // Kept as the second line of defence, and for what reaches FFmpeg without io_open.
+    av_dict_set(&raw_options, "protocol_whitelist", "file,pipe", 0);
+  }
+  const int opened = avformat_open_input(&raw, url.c_str(), nullptr, &raw_options);  // frees raw on failure
+  DictionaryPtr unused(raw_options);
+  if (opened >= 0) format.reset(raw);
+  return opened;
+}
+
+std::string network_refusal(const std::string& path, const NetworkGuard& guard) {
+  return fmt::format("{}: opening it needs network access ({}); pass --allow-network", path, guard.refused_protocol);
+}
+
+}  // namespace nelf::ffmpeg
