@@ -14,6 +14,7 @@
 #include "app/calibrate_session.hpp"
 #include "app/commands.hpp"
 #include "app/input_files.hpp"
+#include "compositor/calibration_controls.hpp"
 #include "compositor/profile.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/image_sink.hpp"
@@ -130,10 +131,13 @@ void run_calibrate(const CalibrateArgs& args) {
 }  // namespace
 
 void save_calibrated_profile(const Profile& profile, const std::string& path) {
+  // The saved file is a profile of its own, not the one it started from.
+  Profile saved = profile;
+  saved.name = calibrated_profile_name(path);
   try {
     write_file_atomically(path, true, [&](const std::filesystem::path& temporary) {
       std::ofstream out(temporary, std::ios::binary);
-      out << profile_to_toml(profile);
+      out << profile_to_toml(saved);
       out.close();
       if (!out) throw ImageWriteError(fmt::format("{}: cannot write the profile (disk full?)", path));
     });

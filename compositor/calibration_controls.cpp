@@ -25,6 +25,14 @@ bool step_within(double& value, double delta, double lo, double hi) {
 
 const char* eye_key(Eye eye) { return eye == Eye::left ? "left" : "right"; }
 
+// The smaller lit fraction of the two eyes; throws ProfileError where the geometry does not work.
+double least_lit_fraction(const Profile& profile, double content_aspect) {
+  double least = 1.0;
+  for (Eye eye : {Eye::left, Eye::right})
+    least = std::min(least, lit_fraction(make_eye_mapping(profile, eye, content_aspect)));
+  return least;
+}
+
 }  // namespace
 
 std::string calibration_eye_name(CalibrationEye eye) {
@@ -39,10 +47,18 @@ std::string calibration_eye_name(CalibrationEye eye) {
   return "both eyes";
 }
 
-CalibrationControls::CalibrationControls(Profile profile, TestPattern pattern, double content_aspect)
-    : profile_(std::move(profile)), pattern_(pattern), content_aspect_(content_aspect) {
-  for (Eye eye : {Eye::left, Eye::right}) make_eye_mapping(profile_, eye, content_aspect_);
+std::string calibrated_profile_name(const std::filesystem::path& save_path) {
+  const std::string stem = save_path.stem().string();
+  for (const auto& builtin : builtin_profiles())
+    if (builtin.name == stem) return stem + "-calibrated";
+  return stem;
 }
+
+CalibrationControls::CalibrationControls(Profile profile, TestPattern pattern, double content_aspect)
+    : profile_(std::move(profile)),
+      pattern_(pattern),
+      content_aspect_(content_aspect),
+      lit_fraction_(least_lit_fraction(profile_, content_aspect_)) {}
 
 const std::vector<std::string>& CalibrationControls::help_lines() {
   static const std::vector<std::string> lines = {
@@ -71,14 +87,23 @@ std::vector<Eye> CalibrationControls::selected() const {
 
 CalibrationStep CalibrationControls::accept(const Profile& candidate, std::string message) {
   CalibrationStep step;
+  double lit = 0.0;
   try {
     // What --save would write must load again, and the compositor must be able to map it.
     parse_profile(profile_to_toml(candidate), candidate.source);
-    for (Eye eye : {Eye::left, Eye::right}) make_eye_mapping(candidate, eye, content_aspect_);
+    lit = least_lit_fraction(candidate, content_aspect_);
   } catch (const std::exception& e) {
     step.message = fmt::format("not changed: {}", e.what());
     return step;
   }
+  // The eye must still see a picture: a myopic prescription, the IPD or a shift can shrink the
+  // screen to a patch and leave the frame nearly black. Moving back towards more light is allowed.
+  if (lit < min_lit_fraction && lit < lit_fraction_) {
+    step.message = fmt::format("not changed: only {:.0f}% of the panel would show the screen (at least {:.0f}%)",
+                               100.0 * lit, 100.0 * min_lit_fraction);
+    return step;
+  }
+  lit_fraction_ = lit;
   profile_ = candidate;
   step.profile_changed = true;
   step.message = std::move(message);

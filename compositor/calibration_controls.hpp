@@ -2,7 +2,8 @@
 // The keys of `nelf calibrate`, without any window: a profile being adjusted, the eye the keys act
 // on and the pattern shown. apply() takes one key press and says what changed, with one line for
 // the on-screen message. Every value stays within the profile's validation rules and the geometry
-// must still work (the screen fits the field of view), so a saved profile always loads.
+// must still work (the screen fits the field of view, and at least min_lit_fraction of each eye's
+// panel still shows it), so a saved profile always loads and shows a picture.
 //
 //   Tab          adjust both eyes / the left eye / the right eye
 //   arrows       shift the image 1 px (Shift: 0.1 px)         calibration.<eye>.shift_px
@@ -13,6 +14,7 @@
 //   d / D        prescription -/+ 0.25 D                       correction.prescription_diopters
 //   1 2 3 4      stripes, grid, Snellen chart, white
 //   w            save now;  h  help (each press the next line);  q / Esc / Ctrl+C  quit
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -24,6 +26,11 @@ namespace nelf {
 
 enum class CalibrationEye { both, left, right };
 std::string calibration_eye_name(CalibrationEye eye);  // "both eyes", "left eye", "right eye"
+
+// The name of a profile saved by `nelf calibrate --save PATH`: the file's stem ("my-hmz" for
+// my-hmz.toml), so that the saved file is never taken for the profile it started from;
+// "<stem>-calibrated" when the stem is a built-in profile's name.
+std::string calibrated_profile_name(const std::filesystem::path& save_path);
 
 struct CalibrationStep {
   bool profile_changed = false;  // re-render with profile()
@@ -55,6 +62,15 @@ class CalibrationControls {
   static constexpr double gap_step_mm = 0.005;
   static constexpr double ipd_step_mm = 0.5;
   static constexpr double prescription_step_diopters = 0.25;
+  // A change that leaves less than this fraction of either eye's panel showing the screen (the
+  // rest black) is refused, unless it shows more than before. See lit_fraction (mapping.hpp).
+  // hmz-t1 lights 44% uncorrected; a myopic prescription pulls the screen in and shrinks it: 17%
+  // at -4 D, 10% at -5 D, nothing at -8.25 D. 15% stops it at -4.25 D, a screen still a good
+  // half of the field of view wide.
+  static constexpr double min_lit_fraction = 0.15;
+
+  // The smaller of the two eyes' lit fractions for the current profile.
+  double lit_fraction() const { return lit_fraction_; }
 
  private:
   CalibrationStep shift(double dx, double dy);
@@ -72,6 +88,7 @@ class CalibrationControls {
   TestPattern pattern_;
   double content_aspect_;
   CalibrationEye eye_ = CalibrationEye::both;
+  double lit_fraction_ = 0.0;
 };
 
 }  // namespace nelf

@@ -165,12 +165,15 @@ VisualField visual_field_for_screen(const EyeMapping& rendering, const Simulator
   f.step_deg = footprint_rad / options.samples_per_footprint * degrees_per_radian;
   f.left_deg = left * degrees_per_radian;
   f.top_deg = top * degrees_per_radian;
-  f.width = static_cast<int>(std::ceil((right - left) * degrees_per_radian / f.step_deg));
-  f.height = static_cast<int>(std::ceil((top - bottom) * degrees_per_radian / f.step_deg));
+  // Checked as doubles: an absurd geometry must not reach the int conversion (NaN or beyond int).
+  const double width = std::ceil((right - left) * degrees_per_radian / f.step_deg);
+  const double height = std::ceil((top - bottom) * degrees_per_radian / f.step_deg);
   constexpr int max_side = 4096;
-  if (f.width < 1 || f.height < 1 || f.width > max_side || f.height > max_side)
-    throw std::invalid_argument(fmt::format("eye simulator: retinal image of {}x{} pixels is out of range (1..{})",
-                                            f.width, f.height, max_side));
+  if (!(width >= 1 && height >= 1 && width <= max_side && height <= max_side))
+    throw std::invalid_argument(
+        fmt::format("eye simulator: retinal image of {}x{} pixels is out of range (1..{})", width, height, max_side));
+  f.width = static_cast<int>(width);
+  f.height = static_cast<int>(height);
   return f;
 }
 

@@ -155,6 +155,18 @@ std::optional<Vec2> view_coordinate(const EyeMapping& m, Vec2 s) {
   return uv;
 }
 
+double lit_fraction(const EyeMapping& m) {
+  constexpr double kSamples = 16384.0;
+  const double pixels = static_cast<double>(m.panel[0]) * m.panel[1];
+  if (!(pixels > 0.0)) return 0.0;
+  const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(pixels / kSamples))));
+  std::size_t lit = 0, total = 0;
+  for (int y = stride / 2; y < m.panel[1]; y += stride)
+    for (int x = stride / 2; x < m.panel[0]; x += stride, ++total)
+      if (view_coordinate_at_pixel(m, x + 0.5, y + 0.5)) ++lit;
+  return total ? static_cast<double>(lit) / static_cast<double>(total) : 0.0;
+}
+
 Vec2 pixel_footprint_uv(const EyeMapping& m) {
   if (!m.has_lens_array) return {m.pixel_pitch_mm.x / m.view_size_mm.x, m.pixel_pitch_mm.y / m.view_size_mm.y};
   const double k = (m.render_distance_mm - m.eye_relief_mm) / m.gap_mm;

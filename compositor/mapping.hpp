@@ -62,6 +62,11 @@ inline std::optional<Vec2> view_coordinate_at_pixel(const EyeMapping& m, double 
 // antialiasing filter must match (DESIGN.md §4).
 Vec2 pixel_footprint_uv(const EyeMapping& m);
 
+// The fraction of the panel's pixels that show the view, measured at pixel centres (on a regular
+// grid of about 2^14 of them for large panels): the rest stay black. It is what the eye still gets
+// of the emulated screen; `nelf calibrate` refuses changes that leave too little of it.
+double lit_fraction(const EyeMapping& m);
+
 // d_r from the profile: screen.distance_mm (0 = virtual_image_mm), pulled in to the far point
 // 1000/|S| mm of a myope's prescription S < 0.
 double render_distance_mm(const Profile& profile);

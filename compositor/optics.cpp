@@ -3,8 +3,19 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace nelf::optics {
+
+int floor_to_int(double x, const char* what) {
+  const double floored = std::floor(x);
+  // The range test is written so that NaN fails it too.
+  if (!(floored >= static_cast<double>(std::numeric_limits<int>::min()) &&
+        floored <= static_cast<double>(std::numeric_limits<int>::max())))
+    throw std::range_error(std::string(what) + " is out of range: " + std::to_string(x));
+  return static_cast<int>(floored);
+}
 
 double gap_mm(double focal_mm, double image_mm, double eye_relief_mm) {
   const double span = image_mm - eye_relief_mm;
@@ -30,9 +41,11 @@ double elemental_image_mm(const AxisGeometry& g) {
   return std::min((g.eye_relief_mm + d_l) / g.eye_relief_mm * g.lens_pitch_mm, g.display_mm);
 }
 
+double lenses_fitting(const AxisGeometry& g) { return g.display_mm / elemental_image_mm(g); }
+
 int lenses_used(const AxisGeometry& g) {
   // A small epsilon keeps an exact fit (w_s = N Δw_s) from flooring to N − 1 through rounding.
-  return static_cast<int>(std::floor(g.display_mm / elemental_image_mm(g) + 1e-9));
+  return floor_to_int(lenses_fitting(g) + 1e-9, "lens count");
 }
 
 double field_of_view_rad(const AxisGeometry& g) {
@@ -45,7 +58,7 @@ int resolution_px(const AxisGeometry& g) {
   const double by_lenses =
       g.image_mm * lenses_used(g) * g.lens_pitch_mm / (g.eye_relief_mm * magnification_of(g) * g.pixel_pitch_mm);
   const double by_pixels = g.display_mm / g.pixel_pitch_mm;
-  return static_cast<int>(std::floor(std::min(by_lenses, by_pixels) + 1e-9));
+  return floor_to_int(std::min(by_lenses, by_pixels) + 1e-9, "spatial resolution");
 }
 
 double eye_box_mm(const AxisGeometry& g) {
@@ -69,7 +82,7 @@ double defocus_blur_mm(const AxisGeometry& g, double depth_mm) {
 
 int resolution_at_depth_px(const AxisGeometry& g, double depth_mm) {
   const double half_fov = field_of_view_rad(g) / 2.0;
-  return static_cast<int>(std::floor(2.0 * depth_mm * std::tan(half_fov) / defocus_blur_mm(g, depth_mm)));
+  return floor_to_int(2.0 * depth_mm * std::tan(half_fov) / defocus_blur_mm(g, depth_mm), "resolution at depth");
 }
 
 DepthOfField depth_of_field(const AxisGeometry& g) {
@@ -91,7 +104,7 @@ double eye_blur_mm(double accommodation_mm, double depth_mm, double pupil_mm) {
 int views_in_pupil(double accommodation_mm, double eye_relief_mm, double pupil_mm, double lens_pitch_mm) {
   const double ratio =
       std::isinf(accommodation_mm) ? 1.0 : std::abs(accommodation_mm - eye_relief_mm) / accommodation_mm;
-  return static_cast<int>(std::floor(ratio * pupil_mm / lens_pitch_mm + 1e-9));
+  return floor_to_int(ratio * pupil_mm / lens_pitch_mm + 1e-9, "views in the pupil");
 }
 
 double simple_magnifier_min_focal_mm(double f_number, double eye_box_mm, double eye_relief_mm, double display_mm) {
@@ -113,7 +126,7 @@ double field_of_view_rad(const AxisGeometry& g) {
 int resolution_px(const AxisGeometry& g) {
   const double by_lens = g.image_mm * g.lens_pitch_mm / (g.eye_relief_mm * magnification_of(g) * g.pixel_pitch_mm);
   const double by_pixels = g.display_mm / g.pixel_pitch_mm;
-  return static_cast<int>(std::floor(std::min(by_lens, by_pixels) + 1e-9));
+  return floor_to_int(std::min(by_lens, by_pixels) + 1e-9, "spatial resolution");
 }
 double eye_box_mm(const AxisGeometry& g) {
   return std::abs(g.image_mm / (g.image_mm - g.eye_relief_mm) * g.lens_pitch_mm -

@@ -21,12 +21,21 @@ struct AxisGeometry {
   std::optional<double> gap_mm;  // d_l when fixed by the hardware; Eq. 1 otherwise
 };
 
+// ⌊x⌋ as an int. Throws
+// std::range_error naming `what` when x is not finite or ⌊x⌋ lies outside int's range, so that
+// no figure of an absurd geometry is cast with undefined behaviour; profile validation refuses such
+// geometries first (compositor/profile.cpp), so a loaded profile never throws here.
+int floor_to_int(double x, const char* what);
+
 // Eq. 1: lens–display gap placing the virtual image at d_o.
 double gap_mm(double focal_mm, double image_mm, double eye_relief_mm);
 // Eq. 2: magnification M = 1 + (d_o − d_e)/f.
 double magnification(double focal_mm, double image_mm, double eye_relief_mm);
 // Eq. 6: elemental image width Δw_s = min((d_e + d_l)/d_e · w_l, w_s).
 double elemental_image_mm(const AxisGeometry& g);
+// Eq. 6: w_s / Δw_s, the lenses that fit (unfloored, so that validation can bound it before it
+// becomes an int).
+double lenses_fitting(const AxisGeometry& g);
 // Eq. 6: lenses used N_l = ⌊w_s / Δw_s⌋.
 int lenses_used(const AxisGeometry& g);
 // Eq. 7: field of view α (radians).

@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 #include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 
 #include "compositor/embedded.hpp"
@@ -92,6 +94,24 @@ std::string nearest_known_key(const std::string& key) {
   return best;
 }
 
+// The bounds of DESIGN.md §11 / docs/profiles.md "Limits": every length and every figure derived
+// from a profile stays in a range where the optics mean something and every count fits an int.
+// Shortest and longest length a profile may give (1 µm .. 1 km; a screen or image farther than a
+// kilometre is at infinity for the eye, 0.001 D).
+constexpr double kMinLengthMm = 0.001;
+constexpr double kMaxLengthMm = 1e6;
+// The finest pixel pitch: 0.1 µm, a fifth of the shortest visible wavelength; no panel comes near.
+constexpr double kMinPixelPitchMm = 1e-4;
+// The largest panel side: a display worn in front of the eye is not a metre wide.
+constexpr double kMaxPanelMm = 1000.0;
+// Each elemental image must span at least this many pixels per axis: with fewer a lens shows a
+// single pixel, one ray, and there is no light field to speak of. This also bounds the lens count
+// by half the panel's pixels (at most 8192 per axis).
+constexpr double kMinElementalImagePx = 2.0;
+// The calibration ranges of `nelf calibrate`'s keys.
+constexpr double kMinPitchScale = 0.5, kMaxPitchScale = 2.0;
+constexpr double kMaxFNumber = 100.0;
+
 // Reads one profile, collecting the first problem as a ProfileError.
 class Reader {
  public:
@@ -174,7 +194,10 @@ class Reader {
     const toml::array* a = node->as_array();
     if (!a || a->size() != 2 || !(*a)[0].is_number() || !(*a)[1].is_number())
       fail(node, key, fmt::format("must be a pair of numbers [x, y], got {}", show(*node)));
-    return Vec2{*(*a)[0].value<double>(), *(*a)[1].value<double>()};
+    const Vec2 v{*(*a)[0].value<double>(), *(*a)[1].value<double>()};
+    if (!std::isfinite(v.x) || !std::isfinite(v.y))
+      fail(node, key, fmt::format("must be a pair of finite numbers, got [{}, {}]", v.x, v.y));
+    return v;
   }
 
   std::optional<std::string> string(const std::string& key) const {
@@ -195,11 +218,91 @@ class Reader {
     if (!ok) fail(find(key), key, fmt::format("must be {}, got {}", rule, value));
   }
   void positive(const std::string& key, double value) const { require(value > 0.0, key, "> 0", value); }
+  // A length > 0 within the sane range of lengths (kMinLengthMm .. kMaxLengthMm).
+  void length(const std::string& key, double value, double min_mm = kMinLengthMm) const {
+    positive(key, value);
+    require(value >= min_mm && value <= kMaxLengthMm, key, fmt::format("between {} and {} mm", min_mm, kMaxLengthMm),
+            value);
+  }
 
  private:
   const toml::table& root_;
   std::string origin_;
 };
+
+optics::AxisGeometry optics_axis(const Profile& p, int axis) {
+  optics::AxisGeometry g;
+  g.display_mm = axis == 0 ? p.display.width_mm() : p.display.height_mm();
+  g.pixel_pitch_mm = axis == 0 ? p.display.pixel_pitch_mm.x : p.display.pixel_pitch_mm.y;
+  g.eye_relief_mm = p.viewing.eye_relief_mm;
+  g.image_mm = p.viewing.virtual_image_mm;
+  if (p.lens_array) {
+    g.lens_pitch_mm = p.lens_array->pitch_mm;
+    g.focal_mm = p.lens_array->focal_length_mm;
+    g.gap_mm = p.lens_array->gap_mm;
+  } else {
+    g.lens_pitch_mm = p.magnifier->width_mm;
+    g.focal_mm = p.magnifier->focal_length_mm;
+  }
+  return g;
+}
+
+// The figures `nelf design` reports and the compositor builds on, bounded (docs/profiles.md,
+// "Limits"): the lens count by the panel's pixels, a field of view strictly between 0 and 180
+// degrees, at least one resolvable pixel, no more views in the pupil than lenses, and every figure
+// finite. Each is refused naming the key that sets it.
+void check_derived_figures(const Reader& r, const Profile& p) {
+  if (!p.lens_array && !p.magnifier) return;
+  const bool lens_array = p.lens_array.has_value();
+  const std::string table = lens_array ? "lens_array" : "magnifier";
+  constexpr const char* axis_names[2] = {"horizontal", "vertical"};
+  int lenses_across = 1;
+  for (int axis = 0; axis < 2; ++axis) {
+    const optics::AxisGeometry g = optics_axis(p, axis);
+    const char* axis_name = axis_names[axis];
+    const int panel_px = p.display.resolution[static_cast<std::size_t>(axis)];
+    if (lens_array) {
+      const double elemental_px = optics::elemental_image_mm(g) / g.pixel_pitch_mm;
+      if (!(elemental_px >= kMinElementalImagePx))
+        r.fail(r.find("lens_array.pitch_mm"), "lens_array.pitch_mm",
+               fmt::format("must give elemental images of at least {} px, got {:.3g} px {} ({:.4g} lenses across the "
+                           "{} px panel, at most {})",
+                           kMinElementalImagePx, elemental_px, axis_name, optics::lenses_fitting(g), panel_px,
+                           static_cast<int>(panel_px / kMinElementalImagePx)));
+      if (axis == 0) lenses_across = optics::lenses_used(g);
+    }
+    const double fov_deg = (lens_array ? optics::field_of_view_rad(g) : optics::magnifier::field_of_view_rad(g)) *
+                           180.0 / std::numbers::pi;
+    if (!(fov_deg > 0.0 && fov_deg < 180.0))
+      r.fail(r.find("viewing.eye_relief_mm"), "viewing.eye_relief_mm",
+             fmt::format("{} gives a {} field of view of {:.6g} deg, which must lie between 0 and 180 deg",
+                         p.viewing.eye_relief_mm, axis_name, fov_deg));
+    const int resolution = lens_array ? optics::resolution_px(g) : optics::magnifier::resolution_px(g);
+    if (resolution < 1)
+      r.fail(r.find(table + ".focal_length_mm"), table + ".focal_length_mm",
+             fmt::format("{} magnifies so much that the {} resolution is {} px (Eq. 8); it must be at least 1 px",
+                         g.focal_mm, axis_name, resolution));
+    const double eye_box = lens_array ? optics::eye_box_mm(g) : optics::magnifier::eye_box_mm(g);
+    const optics::DepthOfField dof = optics::depth_of_field(g);
+    if (!std::isfinite(eye_box) || !std::isfinite(dof.near_mm) || (dof.far_mm && !std::isfinite(*dof.far_mm)))
+      r.fail(r.find(table), "[" + table + "]",
+             fmt::format("gives a {} eye box or depth of field that is not a finite number", axis_name));
+  }
+  if (lens_array) {
+    // Eq. 15: a/w_l views enter the pupil; a pupil wider than the lit lens array would count lenses
+    // that are not there.
+    const double array_mm = lenses_across * p.lens_array->pitch_mm;
+    r.require(p.viewing.pupil_mm <= array_mm, "viewing.pupil_mm",
+              fmt::format("at most the lit lens array's width ({} lenses x {} mm = {:.4g} mm)", lenses_across,
+                          p.lens_array->pitch_mm, array_mm),
+              p.viewing.pupil_mm);
+  }
+  const double app_a =
+      optics::simple_magnifier_min_focal_mm(p.magnifier_comparison.f_number, p.magnifier_comparison.eye_box_mm,
+                                            p.viewing.eye_relief_mm, p.display.width_mm());
+  if (!std::isfinite(app_a))
+    r.fail(r.find("magnifier_comparison"), "[magnifier_comparison]", "gives a magnifier bound that is not finite");
+}
 
 Profile read_profile(const toml::table& root, const std::string& origin) {
   Reader r(root, origin);
@@ -238,6 +341,18 @@ Profile read_profile(const toml::table& root, const std::string& origin) {
   } else {
     r.fail(nullptr, "display.pixel_pitch_mm", "is required but missing (or give display.size_mm)");
   }
+  {
+    const std::string key = pitch ? "display.pixel_pitch_mm" : "display.size_mm";
+    const double finest = std::min(p.display.pixel_pitch_mm.x, p.display.pixel_pitch_mm.y);
+    if (finest < kMinPixelPitchMm)
+      r.fail(r.find(key), key,
+             fmt::format("must give a pixel pitch of at least {} mm, got {:.6g} mm", kMinPixelPitchMm, finest));
+    const double w = p.display.width_mm(), h = p.display.height_mm();
+    if (w > kMaxPanelMm || h > kMaxPanelMm)
+      r.fail(r.find(key), key,
+             fmt::format("must give a panel of at most {} mm a side, got {:.6g} x {:.6g} mm ({} x {} px)", kMaxPanelMm,
+                         w, h, p.display.resolution[0], p.display.resolution[1]));
+  }
 
   // [viewing]
   r.table("viewing", true);
@@ -245,10 +360,10 @@ Profile read_profile(const toml::table& root, const std::string& origin) {
   p.viewing.virtual_image_mm = r.required_number("viewing.virtual_image_mm");
   p.viewing.pupil_mm = r.number_or("viewing.pupil_mm", p.viewing.pupil_mm);
   p.viewing.ipd_mm = r.number_or("viewing.ipd_mm", p.viewing.ipd_mm);
-  r.positive("viewing.eye_relief_mm", p.viewing.eye_relief_mm);
-  r.positive("viewing.virtual_image_mm", p.viewing.virtual_image_mm);
-  r.positive("viewing.pupil_mm", p.viewing.pupil_mm);
-  r.positive("viewing.ipd_mm", p.viewing.ipd_mm);
+  r.length("viewing.eye_relief_mm", p.viewing.eye_relief_mm);
+  r.length("viewing.virtual_image_mm", p.viewing.virtual_image_mm);
+  r.length("viewing.pupil_mm", p.viewing.pupil_mm);
+  r.length("viewing.ipd_mm", p.viewing.ipd_mm);
 
   // [lens_array]
   if (r.table("lens_array", false)) {
@@ -258,10 +373,18 @@ Profile read_profile(const toml::table& root, const std::string& origin) {
     lens.gap_mm = r.number("lens_array.gap_mm");
     lens.rotation_deg = r.number_or("lens_array.rotation_deg", 0.0);
     lens.offset_mm = r.pair("lens_array.offset_mm").value_or(Vec2{});
-    r.positive("lens_array.pitch_mm", lens.pitch_mm);
-    r.positive("lens_array.focal_length_mm", lens.focal_length_mm);
+    r.length("lens_array.pitch_mm", lens.pitch_mm);
+    r.length("lens_array.focal_length_mm", lens.focal_length_mm);
+    r.require(std::abs(lens.rotation_deg) <= 180.0, "lens_array.rotation_deg", "between -180 and 180",
+              lens.rotation_deg);
+    // The lattice's centre stays on the panel, or the lit block of lenses slides off it.
+    const Vec2 half_panel{p.display.width_mm() / 2.0, p.display.height_mm() / 2.0};
+    if (!(std::abs(lens.offset_mm.x) <= half_panel.x && std::abs(lens.offset_mm.y) <= half_panel.y))
+      r.fail(r.find("lens_array.offset_mm"), "lens_array.offset_mm",
+             fmt::format("must be within half the panel ([-{:.6g}, {:.6g}] x [-{:.6g}, {:.6g}] mm), got [{}, {}]",
+                         half_panel.x, half_panel.x, half_panel.y, half_panel.y, lens.offset_mm.x, lens.offset_mm.y));
     if (lens.gap_mm) {
-      r.positive("lens_array.gap_mm", *lens.gap_mm);
+      r.length("lens_array.gap_mm", *lens.gap_mm);
       r.require(*lens.gap_mm < lens.focal_length_mm, "lens_array.gap_mm",
                 fmt::format("< lens_array.focal_length_mm ({}) for a virtual image", lens.focal_length_mm),
                 *lens.gap_mm);
@@ -284,8 +407,8 @@ Profile read_profile(const toml::table& root, const std::string& origin) {
     MagnifierSpec mag;
     mag.width_mm = r.required_number("magnifier.width_mm");
     mag.focal_length_mm = r.required_number("magnifier.focal_length_mm");
-    r.positive("magnifier.width_mm", mag.width_mm);
-    r.positive("magnifier.focal_length_mm", mag.focal_length_mm);
+    r.length("magnifier.width_mm", mag.width_mm);
+    r.length("magnifier.focal_length_mm", mag.focal_length_mm);
     const double min_image = p.viewing.eye_relief_mm + mag.focal_length_mm;
     r.require(p.viewing.virtual_image_mm > min_image, "viewing.virtual_image_mm",
               fmt::format("> viewing.eye_relief_mm + magnifier.focal_length_mm ({})", min_image),
@@ -299,6 +422,10 @@ Profile read_profile(const toml::table& root, const std::string& origin) {
   p.screen.width_mm = r.number_or("screen.width_mm", 0.0);
   p.screen.converge = r.boolean("screen.converge").value_or(true);
   r.require(p.screen.width_mm >= 0.0, "screen.width_mm", ">= 0 (0 = largest that fits)", p.screen.width_mm);
+  r.require(p.screen.width_mm <= kMaxLengthMm, "screen.width_mm", fmt::format("at most {} mm", kMaxLengthMm),
+            p.screen.width_mm);
+  r.require(p.screen.distance_mm <= kMaxLengthMm, "screen.distance_mm", fmt::format("at most {} mm", kMaxLengthMm),
+            p.screen.distance_mm);
   if (p.screen.distance_mm != 0.0) {
     double nearest = p.viewing.eye_relief_mm;
     if (p.lens_array)
@@ -326,6 +453,14 @@ Profile read_profile(const toml::table& root, const std::string& origin) {
     c.rotation_deg = r.number_or(t + ".rotation_deg", 0.0);
     c.pitch_scale = r.number_or(t + ".pitch_scale", 1.0);
     r.positive(t + ".pitch_scale", c.pitch_scale);
+    r.require(c.pitch_scale >= kMinPitchScale && c.pitch_scale <= kMaxPitchScale, t + ".pitch_scale",
+              fmt::format("between {} and {}", kMinPitchScale, kMaxPitchScale), c.pitch_scale);
+    // Half the panel either way (as the calibrate keys allow): beyond it the image is off the panel.
+    const double half_w = p.display.resolution[0] / 2.0, half_h = p.display.resolution[1] / 2.0;
+    if (!(std::abs(c.shift_px.x) <= half_w && std::abs(c.shift_px.y) <= half_h))
+      r.fail(r.find(t + ".shift_px"), t + ".shift_px",
+             fmt::format("must be within half the panel ([-{}, {}] x [-{}, {}] px), got [{}, {}]", half_w, half_w,
+                         half_h, half_h, c.shift_px.x, c.shift_px.y));
     r.require(std::abs(c.rotation_deg) <= 180.0, t + ".rotation_deg", "between -180 and 180", c.rotation_deg);
   }
 
@@ -335,13 +470,29 @@ Profile read_profile(const toml::table& root, const std::string& origin) {
   p.correction.defect_map = r.string("correction.defect_map").value_or("");
   r.require(std::abs(p.correction.prescription_diopters) <= 20.0, "correction.prescription_diopters",
             "between -20 and 20", p.correction.prescription_diopters);
+  if (p.lens_array && p.correction.prescription_diopters < 0.0) {
+    // A myope's far point pulls the emulated screen in (render_distance_mm); it must stay beyond
+    // the display like screen.distance_mm.
+    const double far_point = 1000.0 / -p.correction.prescription_diopters;
+    const double nearest = p.viewing.eye_relief_mm +
+                           p.lens_array->gap_mm.value_or(optics::gap_mm(
+                               p.lens_array->focal_length_mm, p.viewing.virtual_image_mm, p.viewing.eye_relief_mm));
+    if (far_point <= nearest)
+      r.fail(r.find("correction.prescription_diopters"), "correction.prescription_diopters",
+             fmt::format("puts the far point at {:.4g} mm, which must lie beyond the display ({:.4g} mm), got {}",
+                         far_point, nearest, p.correction.prescription_diopters));
+  }
 
   // [magnifier_comparison]
   r.table("magnifier_comparison", false);
   p.magnifier_comparison.eye_box_mm = r.number_or("magnifier_comparison.eye_box_mm", 10.0);
   p.magnifier_comparison.f_number = r.number_or("magnifier_comparison.f_number", 1.0);
-  r.positive("magnifier_comparison.eye_box_mm", p.magnifier_comparison.eye_box_mm);
+  r.length("magnifier_comparison.eye_box_mm", p.magnifier_comparison.eye_box_mm);
   r.positive("magnifier_comparison.f_number", p.magnifier_comparison.f_number);
+  r.require(p.magnifier_comparison.f_number <= kMaxFNumber, "magnifier_comparison.f_number",
+            fmt::format("at most {}", kMaxFNumber), p.magnifier_comparison.f_number);
+
+  check_derived_figures(r, p);
   return p;
 }
 

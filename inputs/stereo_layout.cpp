@@ -127,29 +127,44 @@ std::string_view to_string(DetectionRule rule) {
 }
 
 std::optional<FilenameLayout> layout_from_filename(const std::filesystem::path& filename, double display_aspect) {
-  // `lr`/`rl` say side-by-side only; half or full as metadata decides it, full when the aspect is unknown.
+  // A bare `sbs`/`ou`/`tab` (and `lr`, `rl`, `3d`) names only the arrangement: most "1080p.3D.SBS"
+  // releases are half width, so half or full is decided from the frame's aspect exactly as for
+  // metadata. With no aspect known `sbs`/`tab`/`lr`/`rl` mean full (the common stills convention)
+  // and `3d` half. Only the explicit half/full spellings override the aspect.
+  const bool aspect_known = display_aspect > 0.0;
   const StereoLayout side_by_side =
-      display_aspect > 0.0 && display_aspect < kFullSideBySideMinAspect ? StereoLayout::sbs_half : StereoLayout::sbs;
+      aspect_known && display_aspect < kFullSideBySideMinAspect ? StereoLayout::sbs_half : StereoLayout::sbs;
+  const StereoLayout top_bottom =
+      aspect_known && display_aspect > kFullTopBottomMaxAspect ? StereoLayout::tab_half : StereoLayout::tab;
   const auto tokens = alphanumeric_tokens(filename.filename().string());
   bool says_3d = false;
   for (std::size_t i = 0; i < tokens.size(); ++i) {
     const std::string& t = tokens[i];
     const std::string next = i + 1 < tokens.size() ? tokens[i + 1] : std::string();
-    // Two-token spellings first: "half-sbs", "h.sbs", "half_ou", "full-sbs", "full.tab".
+    const bool next_sbs = next == "sbs";
+    const bool next_tab = next == "tab" || next == "ou";
+    // Two-token spellings first: "half-sbs", "h.sbs", "half_ou", "full-sbs", "f-sbs", "full.tab".
     if (t == "h" || t == "half") {
-      if (next == "sbs") return FilenameLayout{StereoLayout::sbs_half};
-      if (next == "tab" || next == "ou") return FilenameLayout{StereoLayout::tab_half};
+      if (next_sbs) return FilenameLayout{StereoLayout::sbs_half};
+      if (next_tab) return FilenameLayout{StereoLayout::tab_half};
     }
-    if (t == "sbs" || t == "fsbs") return FilenameLayout{StereoLayout::sbs};
-    if (t == "hsbs") return FilenameLayout{StereoLayout::sbs_half};
-    if (t == "tab" || t == "ou" || t == "ftab" || t == "fou") return FilenameLayout{StereoLayout::tab};
-    if (t == "htab" || t == "hou") return FilenameLayout{StereoLayout::tab_half};
+    if (t == "f" || t == "full") {
+      if (next_sbs) return FilenameLayout{StereoLayout::sbs};
+      if (next_tab) return FilenameLayout{StereoLayout::tab};
+    }
+    if (t == "hsbs" || t == "halfsbs") return FilenameLayout{StereoLayout::sbs_half};
+    if (t == "fsbs" || t == "fullsbs") return FilenameLayout{StereoLayout::sbs};
+    if (t == "htab" || t == "hou" || t == "halftab" || t == "halfou") return FilenameLayout{StereoLayout::tab_half};
+    if (t == "ftab" || t == "fou" || t == "fulltab" || t == "fullou") return FilenameLayout{StereoLayout::tab};
+    if (t == "sbs") return FilenameLayout{side_by_side};
+    if (t == "tab" || t == "ou") return FilenameLayout{top_bottom};
     if (t == "lr") return FilenameLayout{side_by_side};
     if (t == "rl") return FilenameLayout{side_by_side, true};
     if (t == "3d") says_3d = true;
   }
-  // "3D" with nothing more specific: release groups mean half side-by-side by it.
-  if (says_3d) return FilenameLayout{StereoLayout::sbs_half};
+  // "3D" with nothing more specific: release groups mean side-by-side by it, half unless the
+  // frame's aspect says full.
+  if (says_3d) return FilenameLayout{aspect_known ? side_by_side : StereoLayout::sbs_half};
   return std::nullopt;
 }
 

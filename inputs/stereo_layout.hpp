@@ -78,9 +78,13 @@ struct LayoutDecision {
 LayoutDecision detect_stereo_layout(const LayoutEvidence& evidence);
 
 // The filename rule alone: release-name tokens (any case, delimited by non-alphanumerics, in the
-// last path component only), e.g. "Movie.2010.3D.HSBS.1080p.mkv" -> sbs-half, "photo_rl.jpg" ->
-// sbs swapped, "clip.3D.mp4" -> sbs-half. `lr`/`rl` say side-by-side but not half or full: with a
-// known `display_aspect` (> 0) that decides as for metadata, otherwise they mean full sbs.
+// last path component only). Explicit spellings decide half or full: `hsbs`, `h-sbs`, `half-sbs`,
+// `halfsbs` are sbs-half; `fsbs`, `f-sbs`, `full-sbs`, `fullsbs` sbs; `htab`, `hou`, `h-ou`,
+// `half-ou`, `halftab`... tab-half; `ftab`, `fou`, `full-ou`, `fulltab`... tab. A bare `sbs`, `ou`,
+// `tab`, `lr`, `rl` or `3d` says only the arrangement (`3d` and `lr`/`rl` side-by-side, `rl`
+// swapped): with a known `display_aspect` (> 0) half or full is decided as for metadata
+// (kFullSideBySideMinAspect, kFullTopBottomMaxAspect), so "Movie.1080p.3D.SBS.mkv" at 1920x1080
+// is sbs-half and at 3840x1080 sbs; with no aspect they mean full, `3d` half.
 // Returns nothing when no token names a layout.
 struct FilenameLayout {
   StereoLayout layout;

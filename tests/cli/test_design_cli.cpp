@@ -216,6 +216,35 @@ TEST(DesignCliBadProfile, LensPitchWiderThanDisplay) {
                         {"lens_array.pitch_mm", "display's smaller side", "got 9"}});
 }
 
+// Absurd but formerly accepted profiles (issue #11): 16384 mm pixels made millions of lenses and hung
+// convert; 1e9 overflowed the lens count (design printed -2147483648 lenses and a -180 deg field of
+// view). Refused with one line naming the file and the key, like every profile error.
+TEST(DesignCliBadProfile, AbsurdPixelPitchIsRefused) {
+  for (const char* pitch : {"16384", "1e9"})
+    expect_profile_error({"pixel-pitch",
+                          with(valid_lens_profile, "pixel_pitch_mm = 0.012", std::string("pixel_pitch_mm = ") + pitch),
+                          {"display.pixel_pitch_mm", "at most 1000 mm a side"}});
+}
+
+TEST(DesignCliBadProfile, ExtremeValuesAreRefused) {
+  const struct {
+    const char *from, *to, *key;
+  } cases[] = {
+      {"pixel_pitch_mm = 0.012", "pixel_pitch_mm = 0", "display.pixel_pitch_mm"},
+      {"pixel_pitch_mm = 0.012", "pixel_pitch_mm = -1e9", "display.pixel_pitch_mm"},
+      {"pixel_pitch_mm = 0.012", "pixel_pitch_mm = nan", "display.pixel_pitch_mm"},
+      {"pixel_pitch_mm = 0.012", "pixel_pitch_mm = inf", "display.pixel_pitch_mm"},
+      {"pixel_pitch_mm = 0.012", "pixel_pitch_mm = 1e-9", "display.pixel_pitch_mm"},
+      {"pitch_mm = 1.0", "pitch_mm = 0.001", "lens_array.pitch_mm"},
+      {"focal_length_mm = 3.3", "focal_length_mm = 3.3\ngap_mm = 1e300", "lens_array.gap_mm"},
+      {"focal_length_mm = 3.3", "focal_length_mm = nan", "lens_array.focal_length_mm"},
+      {"eye_relief_mm = 25.0", "eye_relief_mm = 1e-300", "viewing.eye_relief_mm"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = inf", "viewing.virtual_image_mm"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = 1000.0\npupil_mm = 1e300", "viewing.pupil_mm"},
+  };
+  for (const auto& c : cases) expect_profile_error({"extreme", with(valid_lens_profile, c.from, c.to), {c.key}});
+}
+
 TEST(DesignCli, UnknownBuiltinListsTheBuiltins) {
   const auto r = run_nelf("design --profile hmz-t2");
   EXPECT_EQ(r.status, 2);

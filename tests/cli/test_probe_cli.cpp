@@ -105,6 +105,28 @@ TEST(ProbeCli, HdmiFramePackedSizes) {
   }
 }
 
+// A bare SBS in a release name says side-by-side; the frame's aspect says half (one view's 16:9)
+// or full (two views, 32:9); only FSBS/HSBS-style tokens override it.
+TEST(ProbeCli, ReleaseNameSbsIsHalfOrFullByTheFrame) {
+  TempDir dir;
+  const auto clip = [&](const std::string& name, const std::string& size) {
+    return make_media(dir / name, "-f lavfi -i testsrc2=s=" + size + ":r=10 -frames:v 1 -c:v ffv1");
+  };
+  const nlohmann::json half = probe_json(clip("Movie.1080p.3D.SBS.mkv", "320x180"));
+  EXPECT_EQ(half["layout"], "sbs-half");
+  EXPECT_EQ(half["rule"], "filename");
+  std::filesystem::create_directory(dir / "wide");
+  const nlohmann::json full = probe_json(clip("wide/Movie.1080p.3D.SBS.mkv", "640x180"));
+  EXPECT_EQ(full["layout"], "sbs");
+  EXPECT_EQ(full["rule"], "filename");
+  EXPECT_EQ(probe_json(clip("Movie.1080p.3D.Full-SBS.mkv", "320x180"))["layout"], "sbs");
+  EXPECT_EQ(probe_json(clip("Movie.1080p.3D.OU.mkv", "320x180"))["layout"], "tab-half");
+  // The table says the same, with the rule.
+  const CommandResult r = run_nelf("probe " + shell_quote((dir / "Movie.1080p.3D.SBS.mkv").string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("sbs-half (rule: filename)"), std::string::npos) << r.out;
+}
+
 TEST(ProbeCli, FilenameAspectAndDefault) {
   TempDir dir;
   const std::string plain = "-f lavfi -i testsrc2=s=320x180:r=10 -frames:v 2 -c:v ffv1";

@@ -4,6 +4,7 @@
 
 #include "compositor/calibration_controls.hpp"
 #include "compositor/mapping.hpp"
+#include "compositor/reference.hpp"
 #include "support/test_support.hpp"
 
 namespace nelf {
@@ -108,27 +109,91 @@ TEST(CalibrationControls, LimitsKeepTheProfileValid) {
   EXPECT_NO_THROW(parse_profile(profile_to_toml(c.profile()), "limits.toml"));
 }
 
-TEST(CalibrationControls, AChangeTheGeometryCannotShowIsRefused) {
-  // A strong myopic prescription pulls the screen in to the far point; closer than ~120 mm no
-  // screen fits both eyes' field of view on hmz-t1 (the screen converges half the IPD inwards).
-  // The key that would go there is refused and the profile stays usable.
-  CalibrationControls c(load_profile("hmz-t1"), TestPattern::grid);
+// The fraction of the reference compositor's frame that is lit (not black) for a white pattern:
+// what the eye actually gets to see, measured on the composited pixels rather than the mapping.
+double lit_fraction_of_frame(const Profile& profile, Eye eye) {
+  const EyeMapping m = make_eye_mapping(profile, eye, 16.0 / 9.0);
+  Image white(64, 36);
+  for (Rgba& px : white.pixels()) px = Rgba{1.f, 1.f, 1.f, 1.f};
+  const Image frame = reference_eye_image(m, white, 1);
+  std::size_t lit = 0;
+  for (int y = 0; y < frame.height(); ++y)
+    for (int x = 0; x < frame.width(); ++x) lit += frame.at(x, y).g > 0.5f;
+  return static_cast<double>(lit) / (static_cast<double>(frame.width()) * frame.height());
+}
+
+TEST(CalibrationControls, MyopicPrescriptionStopsBeforeTheFrameGoesDark) {
+  // A myopic prescription pulls the screen in to the far point, where it shrinks to a patch: on
+  // hmz-t1 -4 D already left 40% of the light, -8.25 D an all-black frame that was saved. The
+  // keys stop, with the reason, while at least 15% of each eye's panel shows the screen.
+  CalibrationControls c(load_profile("hmz-t1"), TestPattern::white);
+  const double start = lit_fraction_of_frame(c.profile(), Eye::left);
+  EXPECT_GT(start, 0.4);
+  EXPECT_NEAR(c.lit_fraction(), start, 0.02);
   CalibrationStep step;
   int accepted = 0;
-  for (int i = 0; i < 80 && (accepted == 0 || step.profile_changed); ++i) {
+  for (int i = 0; i < 80; ++i) {
     step = c.apply(key(U'd'));
-    accepted += step.profile_changed;
+    if (!step.profile_changed) break;
+    ++accepted;
   }
   EXPECT_GT(accepted, 4);
   EXPECT_FALSE(step.profile_changed);
   EXPECT_EQ(step.message.rfind("not changed: ", 0), 0u) << step.message;
-  EXPECT_NE(step.message.find("no screen fits"), std::string::npos) << step.message;
+  EXPECT_NE(step.message.find("of the panel would show the screen (at least 15%)"), std::string::npos) << step.message;
   const double last = c.profile().correction.prescription_diopters;
-  EXPECT_GT(last, -20.0);
-  EXPECT_NO_THROW(make_eye_mapping(c.profile(), Eye::left, 16.0 / 9.0));
-  // Back the other way works again.
+  EXPECT_LT(last, -2.0);
+  EXPECT_GT(last, -8.0);
+  // What is kept still shows a picture, measured on the composited frame; one more step would not.
+  for (Eye eye : {Eye::left, Eye::right}) EXPECT_GE(lit_fraction_of_frame(c.profile(), eye), 0.14);
+  Profile darker = c.profile();
+  darker.correction.prescription_diopters -= CalibrationControls::prescription_step_diopters;
+  EXPECT_LT(std::min(lit_fraction_of_frame(darker, Eye::left), lit_fraction_of_frame(darker, Eye::right)), 0.16);
+  // The same refusal on every further press; back the other way works again.
+  EXPECT_FALSE(c.apply(key(U'd')).profile_changed);
   EXPECT_TRUE(c.apply(key(U'D')).profile_changed);
   EXPECT_EQ(c.profile().correction.prescription_diopters, last + 0.25);
+}
+
+TEST(CalibrationControls, ShiftsThatPushTheImageOffThePanelStop) {
+  // Both eyes shifted towards a corner: the lit area shrinks to a quarter of what it was before
+  // the limit of half the panel in both directions.
+  CalibrationControls c(load_profile("hmz-t1"), TestPattern::white);
+  CalibrationStep step;
+  for (int i = 0; i < 400; ++i) c.apply(key(Named::up));
+  EXPECT_EQ(shift_of(c, Eye::left).y, -360.0) << "half the panel up still shows half the screen";
+  for (int i = 0; i < 700; ++i)
+    if (!(step = c.apply(key(Named::left))).profile_changed) break;
+  EXPECT_FALSE(step.profile_changed);
+  EXPECT_GT(shift_of(c, Eye::left).x, -640.0) << "stopped before the key's own limit";
+  EXPECT_NE(step.message.find("would show the screen"), std::string::npos) << step.message;
+  EXPECT_GE(c.lit_fraction(), CalibrationControls::min_lit_fraction);
+  EXPECT_GE(lit_fraction_of_frame(c.profile(), Eye::left), 0.14);
+}
+
+TEST(CalibrationControls, AStartBelowTheThresholdMayOnlyGetBrighter) {
+  Profile dim = load_profile("hmz-t1");
+  dim.correction.prescription_diopters = -7.0;
+  CalibrationControls c(dim, TestPattern::white);
+  EXPECT_LT(c.lit_fraction(), CalibrationControls::min_lit_fraction);
+  EXPECT_FALSE(c.apply(key(U'd')).profile_changed);
+  EXPECT_TRUE(c.apply(key(U'D')).profile_changed);
+  EXPECT_EQ(c.profile().correction.prescription_diopters, -6.75);
+}
+
+TEST(CalibrationControls, AChangeTheGeometryCannotShowIsRefused) {
+  // Closer than ~120 mm no screen fits both eyes' field of view on hmz-t1 (the screen converges
+  // half the IPD inwards): such a profile cannot even be mapped, and a key that would go there is
+  // refused with that reason.
+  Profile p = load_profile("hmz-t1");
+  p.correction.prescription_diopters = -8.5;
+  EXPECT_THROW(make_eye_mapping(p, Eye::left, 16.0 / 9.0), ProfileError);
+  p.correction.prescription_diopters = -8.25;
+  CalibrationControls c(p, TestPattern::grid);
+  const CalibrationStep step = c.apply(key(U'd'));
+  EXPECT_FALSE(step.profile_changed);
+  EXPECT_NE(step.message.find("no screen fits"), std::string::npos) << step.message;
+  EXPECT_EQ(c.profile().correction.prescription_diopters, -8.25);
 }
 
 TEST(CalibrationControls, StockProfileHasNoPitchOrGap) {
@@ -194,7 +259,16 @@ TEST(CalibrationControls, SavedProfileLoadsWithTheAdjustedValues) {
   EXPECT_EQ(*saved.lens_array->gap_mm, *c.profile().lens_array->gap_mm);
   EXPECT_EQ(saved.viewing.ipd_mm, 63.5);
   EXPECT_EQ(saved.correction.prescription_diopters, -0.25);
+  // profile_to_toml keeps the name; `nelf calibrate --save` gives the file its own.
   EXPECT_EQ(saved.name, "hmz-t1");
+}
+
+TEST(CalibrationControls, SavedProfilesGetTheirOwnName) {
+  EXPECT_EQ(calibrated_profile_name("mine.toml"), "mine");
+  EXPECT_EQ(calibrated_profile_name("/home/me/profiles/my-hmz.toml"), "my-hmz");
+  // Never a built-in's name: the file would pass for the profile it started from.
+  EXPECT_EQ(calibrated_profile_name("/tmp/hmz-t1.toml"), "hmz-t1-calibrated");
+  EXPECT_EQ(calibrated_profile_name("hmz-t1-stock.toml"), "hmz-t1-stock-calibrated");
 }
 
 }  // namespace

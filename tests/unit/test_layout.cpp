@@ -383,6 +383,77 @@ TEST(LayoutHints, LeftRightTokensAreHalfOrFullByTheAspect) {
   EXPECT_EQ(d.rule, DetectionRule::filename);
 }
 
+// Release names x frame sizes through the whole chain: a bare SBS/OU/TAB (or 3D) names only the
+// arrangement and the frame's aspect decides half or full, as for metadata; the explicit half and
+// full spellings decide whatever the frame.
+struct ReleaseCase {
+  const char* name;
+  int width, height;
+  StereoLayout layout;
+};
+
+TEST(LayoutChain, ReleaseNamesHalfOrFullByTheFrame) {
+  using L = StereoLayout;
+  const ReleaseCase cases[] = {
+      // Bare tokens: the aspect decides.
+      {"Movie.1080p.3D.SBS.mkv", 1920, 1080, L::sbs_half},
+      {"Movie.1080p.3D.SBS.mkv", 3840, 1080, L::sbs},
+      {"Movie.720p.3D.SBS.x264.mkv", 1280, 720, L::sbs_half},
+      {"Movie.2160p.3D.SBS.mkv", 3840, 2160, L::sbs_half},
+      {"Scope.Movie.3D.SBS.mkv", 1920, 800, L::sbs_half},  // 2.4:1 is one scope view
+      {"Scope.Movie.3D.SBS.mkv", 3840, 800, L::sbs},
+      {"movie [3D] [SBS].mp4", 1920, 1080, L::sbs_half},
+      {"movie_sbs.mp4", 2560, 720, L::sbs},
+      {"Movie.1080p.3D.OU.mkv", 1920, 1080, L::tab_half},
+      {"Movie.1080p.3D.OU.mkv", 1920, 2160, L::tab},
+      {"Movie.3D.TAB.mkv", 1920, 1080, L::tab_half},
+      {"Movie.3D.TAB.mkv", 1280, 1440, L::tab},
+      {"Movie.3D.TAB.mkv", 1920, 1600, L::tab},  // two scope views stacked: 1.2
+      {"Movie.3D.1080p.mkv", 1920, 1080, L::sbs_half},
+      {"Movie.3D.1080p.mkv", 3840, 1080, L::sbs},
+      {"clip.LR.mp4", 1920, 1080, L::sbs_half},
+      {"clip.LR.mp4", 3840, 1080, L::sbs},
+      // Explicit full: full whatever the frame.
+      {"Movie.1080p.3D.FSBS.mkv", 1920, 1080, L::sbs},
+      {"Movie.1080p.3D.Full-SBS.mkv", 1920, 1080, L::sbs},
+      {"Movie.1080p.3D.FullSBS.mkv", 1920, 1080, L::sbs},
+      {"Movie.1080p.3D.Full.SBS.mkv", 1920, 1080, L::sbs},
+      {"Movie.1080p.3D.F-SBS.mkv", 1920, 1080, L::sbs},
+      {"Movie.1080p.3D.FOU.mkv", 1920, 1080, L::tab},
+      {"Movie.1080p.3D.Full-OU.mkv", 1920, 1080, L::tab},
+      {"Movie.1080p.3D.FullOU.mkv", 1920, 1080, L::tab},
+      {"Movie.1080p.3D.FTAB.mkv", 1920, 1080, L::tab},
+      {"Movie.1080p.3D.Full-TAB.mkv", 1920, 1080, L::tab},
+      {"Movie.1080p.3D.FullTAB.mkv", 1920, 1080, L::tab},
+      // Explicit half: half whatever the frame.
+      {"Movie.1080p.3D.HSBS.mkv", 3840, 1080, L::sbs_half},
+      {"Movie.1080p.3D.Half-SBS.mkv", 3840, 1080, L::sbs_half},
+      {"Movie.1080p.3D.H-SBS.mkv", 3840, 1080, L::sbs_half},
+      {"Movie.1080p.3D.HalfSBS.mkv", 3840, 1080, L::sbs_half},
+      {"Movie.1080p.3D.HOU.mkv", 1920, 2160, L::tab_half},
+      {"Movie.1080p.3D.H-OU.mkv", 1920, 2160, L::tab_half},
+      {"Movie.1080p.3D.Half-OU.mkv", 1920, 2160, L::tab_half},
+      {"Movie.1080p.3D.HTAB.mkv", 1920, 2160, L::tab_half},
+      {"Movie.1080p.3D.H-TAB.mkv", 1920, 2160, L::tab_half},
+      {"Movie.1080p.3D.HalfTAB.mkv", 1920, 2160, L::tab_half},
+  };
+  for (const auto& c : cases) {
+    const LayoutDecision d = detect_stereo_layout(plain(c.width, c.height, c.name));
+    EXPECT_EQ(to_string(d.layout), to_string(c.layout)) << c.name << " at " << c.width << "x" << c.height;
+    EXPECT_EQ(d.rule, DetectionRule::filename) << c.name;
+    EXPECT_FALSE(d.swap_eyes) << c.name;
+  }
+}
+
+TEST(LayoutChain, ReleaseNameAspectIncludesTheSampleAspect) {
+  // An anamorphic 1440x1080 frame with 4:3 pixels is displayed 16:9: one view, so half.
+  LayoutEvidence e = plain(1440, 1080, "Movie.3D.SBS.mkv");
+  e.display_aspect = 1440.0 * 4 / 3 / 1080;
+  EXPECT_EQ(detect_stereo_layout(e).layout, StereoLayout::sbs_half);
+  e.display_aspect = 2 * e.display_aspect;
+  EXPECT_EQ(detect_stereo_layout(e).layout, StereoLayout::sbs);
+}
+
 TEST(LayoutChain, SwapEyesFlagComesOnTopOfJps) {
   LayoutEvidence e{std::nullopt, std::nullopt, 2048, 768, "photo.jps"};
   e.swap_eyes = true;

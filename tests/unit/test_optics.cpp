@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "compositor/optics.hpp"
 
@@ -221,6 +222,26 @@ TEST(OpticsMagnifier, IsTheLensArrayModelWithOneLensFillingTheDisplay) {
   EXPECT_DOUBLE_EQ(field_of_view_rad(g), magnifier::field_of_view_rad(g));
   EXPECT_EQ(resolution_px(g), magnifier::resolution_px(g));
   EXPECT_DOUBLE_EQ(eye_box_mm(g), magnifier::eye_box_mm(g));
+}
+
+TEST(OpticsConversions, CountsOutOfIntRangeThrowInsteadOfOverflowing) {
+  EXPECT_EQ(floor_to_int(2.9999, "x"), 2);
+  EXPECT_EQ(floor_to_int(-0.5, "x"), -1);
+  EXPECT_EQ(floor_to_int(2147483647.5, "x"), 2147483647);
+  for (double bad : {std::nan(""), kInfinity, -kInfinity, 2147483648.0, -2147483649.0, 1e300})
+    EXPECT_THROW(floor_to_int(bad, "x"), std::range_error) << bad;
+  // 1e9 mm pixels (the absurd profile of issue #11): 1.28e12 mm of panel under 1 mm lenses is
+  // more lenses than an int holds; it used to come out as -2147483648 and a -180 deg field of view.
+  AxisGeometry g = hmz(0);
+  g.pixel_pitch_mm = 1e9;
+  g.display_mm = 1280 * 1e9;
+  EXPECT_GT(lenses_fitting(g), 1e11);
+  EXPECT_THROW(lenses_used(g), std::range_error);
+  EXPECT_THROW(field_of_view_rad(g), std::range_error);
+  EXPECT_THROW(resolution_px(g), std::range_error);
+  // Views in the pupil: a 1e300 mm pupil over 1 mm lenses.
+  EXPECT_THROW(views_in_pupil(kInfinity, 25.0, 1e300, 1.0), std::range_error);
+  EXPECT_EQ(views_in_pupil(kInfinity, 25.0, 4.0, 1.0), 4);
 }
 
 }  // namespace

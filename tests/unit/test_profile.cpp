@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <stdexcept>
+#include <string>
+#include <vector>
+
 #include "compositor/profile.hpp"
 
 namespace nelf {
@@ -155,6 +159,136 @@ TEST(ProfileErrors, LensWiderThanDisplay) {
   text.replace(text.find("pitch_mm = 1.0"), 14, "pitch_mm = 9");
   const auto e = error_of(text);
   EXPECT_NE(e.find("lens_array.pitch_mm must be <= the display's smaller side"), std::string::npos) << e;
+}
+
+// --- bounds on every length and derived figure (docs/profiles.md "Limits") -------------------------
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  if (at == std::string::npos) throw std::logic_error("test profile has no '" + from + "'");
+  return text.replace(at, from.size(), to);
+}
+
+// One line naming the file and the key, and each expected part of the rule.
+void expect_refused(const std::string& text, const std::string& key, const std::vector<std::string>& parts = {}) {
+  SCOPED_TRACE(text);
+  const std::string e = error_of(text);
+  ASSERT_FALSE(e.empty()) << "accepted";
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  EXPECT_EQ(e.rfind("dev.toml", 0), 0u) << e;
+  EXPECT_NE(e.find(key), std::string::npos) << e;
+  for (const auto& part : parts) EXPECT_NE(e.find(part), std::string::npos) << e;
+}
+
+TEST(ProfileBounds, HugePixelPitchIsRefusedByThePanelSize) {
+  // 16384 mm pixels made a 21 km panel with millions of 1 mm lenses (convert hung); 1e9 overflowed
+  // the lens count.
+  for (const char* pitch : {"16384", "1e9", "1e300", "0.8"}) {
+    expect_refused(replaced(minimal_lens_profile, "pixel_pitch_mm = 0.012", std::string("pixel_pitch_mm = ") + pitch),
+                   "display.pixel_pitch_mm", {"at most 1000 mm a side"});
+  }
+  expect_refused(replaced(minimal_lens_profile, "pixel_pitch_mm = 0.012", "size_mm = [15.36, 1e12]"), "display.size_mm",
+                 {"at most 1000 mm a side"});
+  // 0.78 mm pixels make a 998 x 562 mm panel: large, but a panel.
+  EXPECT_EQ(error_of(replaced(replaced(minimal_lens_profile, "pixel_pitch_mm = 0.012", "pixel_pitch_mm = 0.78"),
+                              "pitch_mm = 1.0", "pitch_mm = 2.0")),
+            "");
+}
+
+TEST(ProfileBounds, TinyPixelPitchIsRefused) {
+  for (const char* pitch : {"1e-5", "1e-300", "5e-324"})
+    expect_refused(replaced(minimal_lens_profile, "pixel_pitch_mm = 0.012", std::string("pixel_pitch_mm = ") + pitch),
+                   "display.pixel_pitch_mm", {"at least 0.0001 mm"});
+}
+
+TEST(ProfileBounds, LensesMustCoverAtLeastTwoPixels) {
+  // 0.01 mm lenses on 12 µm pixels: 0.94 px per elemental image, 1360 lenses across 1280 px.
+  expect_refused(replaced(minimal_lens_profile, "pitch_mm = 1.0", "pitch_mm = 0.01"), "lens_array.pitch_mm",
+                 {"at least 2 px", "horizontal", "at most 640"});
+  // Two pixels is enough: 0.0212 mm lenses give 2.0 px (d_e + d_l)/d_e · w_l / p.
+  EXPECT_EQ(error_of(replaced(minimal_lens_profile, "pitch_mm = 1.0", "pitch_mm = 0.0215")), "");
+}
+
+TEST(ProfileBounds, NonFiniteAndExtremeValuesAreRefused) {
+  struct Case {
+    const char *from, *to, *key;
+  };
+  const Case cases[] = {
+      {"pixel_pitch_mm = 0.012", "pixel_pitch_mm = nan", "display.pixel_pitch_mm"},
+      {"pixel_pitch_mm = 0.012", "pixel_pitch_mm = inf", "display.pixel_pitch_mm"},
+      {"pixel_pitch_mm = 0.012", "pixel_pitch_mm = 0", "display.pixel_pitch_mm"},
+      {"pixel_pitch_mm = 0.012", "size_mm = [nan, 8.64]", "display.size_mm"},
+      {"pixel_pitch_mm = 0.012", "size_mm = [inf, 8.64]", "display.size_mm"},
+      {"pitch_mm = 1.0", "pitch_mm = -inf", "lens_array.pitch_mm"},
+      {"focal_length_mm = 3.3", "focal_length_mm = 1e-9", "lens_array.focal_length_mm"},
+      {"focal_length_mm = 3.3", "focal_length_mm = 1e300", "lens_array.focal_length_mm"},
+      {"focal_length_mm = 3.3", "focal_length_mm = 3.3\ngap_mm = 1e300", "lens_array.gap_mm"},
+      {"focal_length_mm = 3.3", "focal_length_mm = 3.3\ngap_mm = -1", "lens_array.gap_mm"},
+      {"focal_length_mm = 3.3", "focal_length_mm = 3.3\noffset_mm = [nan, 0]", "lens_array.offset_mm"},
+      {"focal_length_mm = 3.3", "focal_length_mm = 3.3\noffset_mm = [1e9, 0]", "lens_array.offset_mm"},
+      {"focal_length_mm = 3.3", "focal_length_mm = 3.3\nrotation_deg = 1e300", "lens_array.rotation_deg"},
+      {"eye_relief_mm = 25.0", "eye_relief_mm = 1e-300", "viewing.eye_relief_mm"},
+      {"eye_relief_mm = 25.0", "eye_relief_mm = nan", "viewing.eye_relief_mm"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = 1e300", "viewing.virtual_image_mm"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = inf", "viewing.virtual_image_mm"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = 1000.0\npupil_mm = 1e300", "viewing.pupil_mm"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = 1000.0\npupil_mm = 40", "viewing.pupil_mm"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = 1000.0\nipd_mm = -63", "viewing.ipd_mm"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = 1000.0\n[screen]\nwidth_mm = 1e300", "screen.width_mm"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = 1000.0\n[screen]\ndistance_mm = 1e300", "screen.distance_mm"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = 1000.0\n[calibration.left]\npitch_scale = 1e-300",
+       "calibration.left.pitch_scale"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = 1000.0\n[calibration.right]\nshift_px = [0, 1e300]",
+       "calibration.right.shift_px"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = 1000.0\n[calibration.right]\nshift_px = [inf, 0]",
+       "calibration.right.shift_px"},
+      {"virtual_image_mm = 1000.0", "virtual_image_mm = 1000.0\n[magnifier_comparison]\nf_number = 1e200",
+       "magnifier_comparison.f_number"},
+  };
+  for (const auto& c : cases) expect_refused(replaced(minimal_lens_profile, c.from, c.to), c.key);
+}
+
+TEST(ProfileBounds, MagnifierFiguresAreBoundedToo) {
+  const std::string loupe = R"(
+[display]
+resolution = [1600, 1200]
+pixel_pitch_mm = 0.01
+[magnifier]
+width_mm = 20.0
+focal_length_mm = 40.0
+[viewing]
+eye_relief_mm = 20.0
+virtual_image_mm = 2000.0
+)";
+  EXPECT_EQ(error_of(loupe), "");
+  expect_refused(replaced(loupe, "eye_relief_mm = 20.0", "eye_relief_mm = 1e-300"), "viewing.eye_relief_mm");
+  expect_refused(replaced(loupe, "width_mm = 20.0", "width_mm = 1e300"), "magnifier.width_mm");
+}
+
+TEST(ProfileBounds, StrongPrescriptionMustLeaveTheScreenBeyondTheDisplay) {
+  // Far point 1000/20 = 50 mm, behind a display at 60 + 3.3 mm.
+  const std::string far_relief = replaced(replaced(minimal_lens_profile, "eye_relief_mm = 25.0", "eye_relief_mm = 60"),
+                                          "virtual_image_mm = 1000.0",
+                                          "virtual_image_mm = 1000.0\n[correction]\n"
+                                          "prescription_diopters = -20");
+  expect_refused(far_relief, "correction.prescription_diopters", {"far point at 50 mm", "beyond the display"});
+}
+
+TEST(ProfileBounds, EveryFigureOfAnAcceptedProfileFitsItsType) {
+  // The extremes the rules allow still give finite figures and counts that fit an int.
+  const std::string extreme = R"(
+[display]
+resolution = [16384, 16384]
+pixel_pitch_mm = 0.061
+[lens_array]
+pitch_mm = 0.25
+focal_length_mm = 0.5
+[viewing]
+eye_relief_mm = 0.001
+virtual_image_mm = 1000000
+pupil_mm = 1
+)";
+  EXPECT_EQ(error_of(extreme), "");
 }
 
 TEST(ProfileErrors, MissingRequiredTable) {
