@@ -7,25 +7,13 @@
 #include "app/commands.hpp"
 #include "compositor/profile.hpp"
 
-namespace {
-
-constexpr nelf::app::CommandRegistrar registrars[] = {
-    nelf::app::add_profiles_command,  nelf::app::add_design_command,   nelf::app::add_convert_command,
-    nelf::app::add_probe_command,     nelf::app::add_simulate_command, nelf::app::add_play_command,
-    nelf::app::add_calibrate_command,
-};
-
-}  // namespace
-
 int main(int argc, char** argv) {
   // A write past the file size limit (`ulimit -f`) would otherwise kill nelf with SIGXFSZ in the
   // middle of a file, leaving it half-written; ignored, the write fails with EFBIG, which every sink
   // reports in one line and cleans up after, as it does for a full disk (ENOSPC).
   std::signal(SIGXFSZ, SIG_IGN);
-  CLI::App app{"nelf: watch 3D movies and play stereo games on near-eye light field displays", "nelf"};
-  app.set_version_flag("--version", fmt::format("nelf {}", NELF_VERSION));
-  app.require_subcommand(1);
-  for (auto add : registrars) add(app);
+  CLI::App app;
+  nelf::app::build_cli(app);
 
   try {
     app.parse(argc, argv);
