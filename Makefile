@@ -5,7 +5,7 @@ ASAN_BUILD ?= build-asan
 JOBS       ?= $(shell nproc)
 CMAKE_ARGS ?=
 
-.PHONY: all deps configure build test test-unit test-asan demo package format clean
+.PHONY: all deps configure build build-app test test-unit test-asan demo package format clean
 
 all: build
 
@@ -18,6 +18,10 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
+# Only the nelf binary and its module: what the demo runs (not the test suites and benchmarks).
+build-app: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target nelf nelf_oiio
+
 # All tests, then the unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer.
 test: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
@@ -29,7 +33,7 @@ test-asan: deps
 	@cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --output-on-failure -j $(JOBS) -L unit
 
-demo: build
+demo: build-app
 	@bash packaging/demo.sh $(BUILD)/nelf
 
 package: build

@@ -73,4 +73,8 @@ void add_simulate_command(CLI::App& app);
 void add_play_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
 
+// Names `app` nelf and adds --version and every subcommand (app/cli.cpp): the command line that
+// main() parses and the man page and completions are generated from.
+void build_cli(CLI::App& app);
+
 }  // namespace nelf::app

@@ -2,7 +2,6 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <cerrno>
-#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <string>
@@ -14,12 +13,6 @@
 #include "inputs/printable.hpp"
 
 namespace {
-
-constexpr nelf::app::CommandRegistrar registrars[] = {
-    nelf::app::add_profiles_command,  nelf::app::add_design_command,   nelf::app::add_convert_command,
-    nelf::app::add_probe_command,     nelf::app::add_simulate_command, nelf::app::add_play_command,
-    nelf::app::add_calibrate_command,
-};
 
 // The status of a program that SIGPIPE ended, without the signal: the reader of nelf's output went
 // away (`nelf probe --json IN | head -c1`), after nelf cleaned up as for any other failure.
@@ -34,22 +27,6 @@ void print_error_line(const std::string& message) {
   std::fwrite(line.data(), 1, line.size(), stderr);
 }
 
-// CLI11 reads "nan" and "inf" as numbers; no option of nelf means either (a time, a diameter).
-// Applied here to every floating-point option of every command, so that a new one cannot miss it.
-void refuse_non_finite_numbers(CLI::App& app) {
-  const CLI::Validator finite(
-      [](std::string& text) -> std::string {
-        double value = 0;
-        if (CLI::detail::lexical_cast(text, value) && !std::isfinite(value))
-          return "must be a finite number, got " + text;
-        return {};
-      },
-      "");
-  for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; }))
-    for (CLI::Option* option : command->get_options())
-      if (option->get_type_name() == "FLOAT") option->check(finite);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -62,11 +39,8 @@ int main(int argc, char** argv) {
   // Ignored, the write fails with EPIPE: a diagnostic write is dropped, and EPIPE on an output
   // (stdout, or any sink writing to a pipe) unwinds like any failure, cleaning up, and ends quietly.
   std::signal(SIGPIPE, SIG_IGN);
-  CLI::App app{"nelf: watch 3D movies and play stereo games on near-eye light field displays", "nelf"};
-  app.set_version_flag("--version", fmt::format("nelf {}", NELF_VERSION));
-  app.require_subcommand(1);
-  for (auto add : registrars) add(app);
-  refuse_non_finite_numbers(app);
+  CLI::App app;
+  nelf::app::build_cli(app);
 
   try {
     app.parse(argc, argv);

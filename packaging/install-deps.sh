@@ -16,8 +16,11 @@ packages=(
   ffmpeg libopenimageio-dev libpng-dev
   # maths, configuration, CLI, formatting, JSON, audio
   libglm-dev libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libsdl2-dev
-  # tests
-  libgtest-dev libgmock-dev
+  # tests (zsh and fish: the completion checks run them)
+  libgtest-dev libgmock-dev zsh fish
+  # the package checks (tests/package): the man page rendered as lintian does, lintian itself,
+  # AppStream validation and the MIME database
+  man-db lintian appstream shared-mime-info
   # fonts for the text of `nelf design --plot` (OpenImageIO render_text)
   fonts-dejavu-core
 )
