@@ -2,10 +2,14 @@
 # they install missing system packages first (packaging/install-deps.sh).
 BUILD      ?= build
 ASAN_BUILD ?= build-asan
+FUZZ_BUILD ?= build-fuzz
+FUZZ_TIME  ?= 60
+# `make test` runs each fuzz target this many seconds (CI's bounded run; docs/fuzzing.md).
+CI_FUZZ_TIME ?= 30
 JOBS       ?= $(shell nproc)
 CMAKE_ARGS ?=
 
-.PHONY: all deps configure build build-app test test-unit test-asan demo package format clean
+.PHONY: all deps configure build build-app test test-unit test-asan fuzz-build fuzz demo package format clean
 
 all: build
 
@@ -26,12 +30,23 @@ build-app: configure
 test: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 	@$(MAKE) --no-print-directory test-asan
+	@$(MAKE) --no-print-directory fuzz FUZZ_TIME=$(CI_FUZZ_TIME)
 
 test-asan: deps
 	@cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DNELF_SANITIZE=ON -DNELF_WERROR=ON $(CMAKE_ARGS) >/dev/null
 	@cmake --build $(ASAN_BUILD) -j $(JOBS) --target nelf_unit_tests
 	@cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --output-on-failure -j $(JOBS) -L unit
+
+# libFuzzer targets (tests/fuzz, docs/fuzzing.md): a clang build of their own, then each target runs
+# FUZZ_TIME seconds; fails on a crash, leak, timeout or out-of-memory input (kept in
+# $(FUZZ_BUILD)/fuzz-artifacts/).
+fuzz-build: deps
+	@cmake -S . -B $(FUZZ_BUILD) -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DNELF_FUZZ=ON $(CMAKE_ARGS) >/dev/null
+	@cmake --build $(FUZZ_BUILD) -j $(JOBS)
+
+fuzz: fuzz-build
+	@bash tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD) $(FUZZ_TIME)
 
 demo: build-app
 	@bash packaging/demo.sh $(BUILD)/nelf
@@ -43,4 +58,4 @@ format:
 	@clang-format -i $$(git ls-files '*.cpp' '*.hpp')
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) demo
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) demo

@@ -6,6 +6,8 @@ set -euo pipefail
 packages=(
   # toolchain
   build-essential cmake pkg-config git clang-format file dpkg-dev
+  # clang and its libFuzzer + sanitizer runtimes (a Recommends, so named) for the fuzz targets (make fuzz)
+  clang libclang-rt-14-dev
   # graphics: EGL/OpenGL through epoxy, Mesa's llvmpipe for GPU-less tests, GLFW windows, KMS/GBM
   libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libgbm-dev libdrm-dev libglfw3-dev libxrandr-dev libx11-dev
   glslang-tools xvfb xauth

@@ -276,6 +276,28 @@ TEST(StillSource, MpoIndexBeatsScanning) {
   EXPECT_EQ(find_mpo_images(broken_bytes), find_jpeg_images(broken_bytes));
 }
 
+// An MP index whose right-image entry points back at the first image: taking it would decode an empty
+// left view ("cannot decode" for a good file); it is ignored in favour of scanning, as a broken
+// index is. Found by tests/fuzz/fuzz_still.
+TEST(StillSource, MpoIndexListingOneImageTwiceIsIgnored) {
+  TempDir dir;
+  const std::string left = jpeg_bytes(dir, filled_image(48, 32, kReddish), "l.jpg");
+  const std::string right = jpeg_bytes(dir, filled_image(48, 32, kBluish), "r.jpg");
+  std::string mpo = test::mpo_with_index(left, "", right);
+  // The right image's MP entry: attribute 0x00020002, size, then the offset, which becomes 0 (= the
+  // start of the file, where the left image is).
+  const std::size_t entry = mpo.find(test::le32(0x00020002) + test::le32(static_cast<std::uint32_t>(right.size())));
+  ASSERT_NE(entry, std::string::npos);
+  mpo.replace(entry + 8, 4, test::le32(0));
+  const auto bytes = std::as_bytes(std::span(mpo.data(), mpo.size()));
+  const std::size_t right_start = mpo.size() - right.size();
+  EXPECT_EQ(find_mpo_images(bytes), (std::vector<std::size_t>{0, right_start}));
+  test::write_file(dir / "twice.mpo", mpo);
+  const StillStereo s = load_still(dir / "twice.mpo", {});
+  EXPECT_TRUE(reddish(s.views.left.image.at(0, 0)));
+  EXPECT_TRUE(bluish(s.views.right.image.at(0, 0)));
+}
+
 TEST(StillSource, BadMpo) {
   TempDir dir;
   const std::string left = jpeg_bytes(dir, filled_image(48, 32, kReddish), "l.jpg");

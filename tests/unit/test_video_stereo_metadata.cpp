@@ -2,6 +2,13 @@
 // StereoMode as stream side data, the H.264 frame-packing SEI as frame side data).
 #include <gtest/gtest.h>
 
+extern "C" {
+#include <libavutil/frame.h>
+#include <libavutil/stereo3d.h>
+}
+
+#include <cstring>
+#include <memory>
 #include <string>
 
 #include "inputs/stereo_metadata.hpp"
@@ -52,6 +59,23 @@ TEST(StereoMetadataMapping, UnsupportedPackingsSayWhatTheyAre) {
       EXPECT_NE(std::string(e.what()).find("--layout"), std::string::npos) << e.what();
     }
   }
+}
+
+// A newer FFmpeg at run time than this build's headers can store a stereo type they do not list (FFmpeg 7
+// added AV_STEREO3D_UNSPEC = 8). Reading it must not load it as the enum: under UBSan (make
+// test-asan) that load is a "not a valid value for type 'enum AVStereo3DType'" error. Found by
+// tests/fuzz/fuzz_stereo_metadata.
+TEST(StereoMetadataFromSideData, ATypeThisBuildDoesNotListIsNoMetadata) {
+  std::unique_ptr<AVFrame, void (*)(AVFrame*)> frame(av_frame_alloc(), [](AVFrame* f) { av_frame_free(&f); });
+  ASSERT_TRUE(frame);
+  AVStereo3D* stereo = av_stereo3d_create_side_data(frame.get());
+  ASSERT_NE(stereo, nullptr);
+  for (const int unknown : {AV_STEREO3D_COLUMNS + 1, 1768649473}) {
+    std::memcpy(&stereo->type, &unknown, sizeof unknown);
+    EXPECT_FALSE(stereo_metadata_from_frame(*frame).has_value()) << unknown;
+  }
+  stereo->type = AV_STEREO3D_TOPBOTTOM;  // and a known one still reads
+  EXPECT_EQ(stereo_metadata_from_frame(*frame), (StereoMetadata{StereoPacking::top_bottom, false}));
 }
 
 class StereoMetadataFromFile : public ::testing::Test {
