@@ -41,6 +41,13 @@ int guarded_io_open(AVFormatContext* context, AVIOContext** pb, const char* url,
   return default_io_open()(context, pb, url, flags, options);
 }
 
+// Once a URL was refused there is nothing left to wait for: a live HLS playlist (no #EXT-X-ENDLIST)
+// whose segments are refused would otherwise be reloaded every target duration, up to
+// m3u8_hold_counters (1000) times, before opening gives up (~17 min for 1 s segments).
+int stop_after_refusal(void* opaque) {
+  return static_cast<const NetworkGuard*>(opaque)->refused_protocol.empty() ? 0 : 1;
+}
+
 }  // namespace
 
 bool is_url(const std::string& path) { return path.find("://") != std::string::npos || path.rfind("pipe:", 0) == 0; }
@@ -57,6 +64,7 @@ int open_input(FormatContextPtr& format, const std::string& path, NetworkGuard& 
     }
     raw->opaque = &guard;
     raw->io_open = guarded_io_open;
+    raw->interrupt_callback = AVIOInterruptCB{stop_after_refusal, &guard};
     // Kept as the second line of defence, and for what reaches FFmpeg without io_open.
     av_dict_set(&raw_options, "protocol_whitelist", "file,pipe", 0);
   }

@@ -99,6 +99,11 @@ TEST(CliContract, PlaylistWithNetworkSegmentsNamesAllowNetwork) {
   expect_clean_failure(dir, "probe " + list, 1,
                        "list.m3u8: opening it needs network access (http); pass --allow-network");
   expect_clean_failure(dir, "convert " + list + " " + q(dir / "out.mkv"), 1, "pass --allow-network");
+  // A live playlist (no #EXT-X-ENDLIST) is reloaded every target duration while its segments fail:
+  // the refusal must end the opening, not 1000 reloads.
+  write_file(dir / "live.m3u8", "#EXTM3U\n#EXT-X-TARGETDURATION:1\n#EXTINF:1,\nhttp://127.0.0.1:9/a.ts\n");
+  expect_clean_failure(dir, "probe " + q(dir / "live.m3u8"), 1,
+                       "live.m3u8: opening it needs network access (http); pass --allow-network");
   expect_clean_failure(dir, "probe http://127.0.0.1:9/film.mkv", 1,
                        "needs network access (http); pass --allow-network");
   EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(30));

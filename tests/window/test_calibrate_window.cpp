@@ -113,7 +113,6 @@ TEST_F(CalibrateWindowTest, KeysChangeWhatSaveWrites) {
   const Profile start = load_profile("hmz-t1");
   // The saved file is a profile of its own, named after the file, not the built-in it started from.
   EXPECT_EQ(p.name, "mine");
-  EXPECT_NE(test::read_file(saved).find("name = \"mine\"\n"), std::string::npos) << test::read_file(saved);
   EXPECT_EQ(p.eye_calibration(Eye::left).shift_px, (Vec2{2.0, -0.1}));
   EXPECT_EQ(p.eye_calibration(Eye::left).rotation_deg, 0.1);
   EXPECT_EQ(p.eye_calibration(Eye::left).pitch_scale, 1.0005);
