@@ -115,6 +115,7 @@ void check_save_path(const std::string& path) {
 
 void run_calibrate(const CalibrateArgs& args) {
   if (!is_output_kind(args.output)) return write_pattern_image(args);
+  refuse_gpu_for_live_output(args.gpu, "a live calibration");
   CalibrateSession session;
   session.output = parse_output_kind(args.output);
   session.pattern = args.pattern.empty() ? TestPattern::stripes : parse_pattern_option(args.pattern);
@@ -167,7 +168,8 @@ void add_calibrate_command(CLI::App& app) {
       "--signal", args->signal,
       fmt::format("Output signal: {} (default: the profile's output.signal)", fmt::join(signal_names(), ", ")));
   cmd->add_option("--fsaa", args->fsaa, "Antialiasing: 0, 1, 4 or 16 (as for convert)")->capture_default_str();
-  cmd->add_option("--gpu", args->gpu, "EGL device index (image output)");
+  cmd->add_option("--gpu", args->gpu,
+                  "EGL device index (image output only; a live output renders on its display's GPU)");
   cmd->add_flag("-y,--overwrite", args->overwrite, "Replace the image --output if it exists");
   cmd->callback([args] { run_calibrate(*args); });
 }

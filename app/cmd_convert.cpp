@@ -216,6 +216,14 @@ CommonOptions parse_common_options(const CommonArgs& args, bool still) {
   return common;
 }
 
+void refuse_gpu_for_live_output(const std::optional<int>& gpu, const std::string& command) {
+  if (!gpu) return;
+  throw UserError(fmt::format("--gpu picks the GPU of headless rendering (convert, simulate, calibrate --output FILE); "
+                              "{} renders on its display's GPU (--output kms: NELF_DRM_DEVICE picks the card)",
+                              command),
+                  2);
+}
+
 void add_common_options(CLI::App& cmd, CommonArgs& args) {
   cmd.add_option("input", args.input, "Stereo image or video (side-by-side, top-bottom, frame-packed, JPS, MPO, ...)")
       ->required();

@@ -30,6 +30,7 @@ struct PlayArgs : CommonArgs {
 
 void run_play(const PlayArgs& args) {
   quiet_ffmpeg_logs(true);
+  refuse_gpu_for_live_output(args.gpu, "play");
   CommonOptions common = parse_common_options(args, false);
   OutputKind kind;
   try {

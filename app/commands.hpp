@@ -52,6 +52,10 @@ void add_max_pixels_option(CLI::App& cmd, std::int64_t& max_pixels);
 // Throws UserError (status 2) for contradictory options and unknown signals, ProfileError for bad
 // profiles. `still`: the input is a still image (refuses layout alt).
 CommonOptions parse_common_options(const CommonArgs& args, bool still);
+
+// --gpu picks the EGL device of headless rendering; a live output renders on its display's own GPU
+// (a GLX context, or the DRM card of kms), so there the option is refused rather than ignored.
+void refuse_gpu_for_live_output(const std::optional<int>& gpu, const std::string& command);
 // The signal named `name` (--signal), or the profile's output.signal when `name` is empty.
 // Throws UserError (status 2) naming the signals there are.
 Signal resolve_signal(const Profile& profile, const std::string& name);

@@ -126,6 +126,7 @@ TEST(CalibrateCli, BadArgumentsSayWhatAndWriteNothing) {
       {"--pattern grid --save " + shell_quote((dir / "x.toml").string()) + " --output " + out, 2,
        "nelf: --save keeps what the keys adjusted and needs a window"},
       {"--pattern grid --fsaa 3 --output " + out, 2, "fsaa"},
+      {"--pattern grid --gpu 0", 2, "a live calibration renders on its display's GPU"},
   };
   for (const auto& c : cases) {
     const auto r = run_nelf("calibrate " + c.args);

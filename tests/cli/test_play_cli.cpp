@@ -262,5 +262,17 @@ TEST(PlayCliErrors, BadInputsAsConvertSaysThem) {
       << output.err;
 }
 
+// --gpu picks the EGL device headless rendering uses; play renders on its display's own GPU, so the
+// option would be ignored: it is refused instead, before anything opens.
+TEST(PlayCliErrors, GpuIsRefusedAsItCannotApply) {
+  TempDir dir;
+  const auto clip = make_clip(dir, "clip.mp4", 1, 24, false);
+  const auto r = run_command("env -u DISPLAY " + std::string(NELF_BINARY) + " play " + q(clip) + " --gpu 0");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err,
+            "nelf: --gpu picks the GPU of headless rendering (convert, simulate, calibrate --output FILE); "
+            "play renders on its display's GPU (--output kms: NELF_DRM_DEVICE picks the card)\n");
+}
+
 }  // namespace
 }  // namespace nelf::test
