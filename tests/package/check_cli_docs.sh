@@ -5,6 +5,8 @@
 # generated from the CLI's definitions, and this catches a generator that misses or invents one.
 # The completions are run (bash and fish), not only read; the page is rendered as lintian does.
 set -euo pipefail
+# Under pipefail a `grep -q` that stops reading at its match makes the writer die of SIGPIPE when it
+# writes on (bash writes each line of printf apart): the greps below read their whole input.
 nelf=$1
 docs=$2
 failures=0
@@ -47,7 +49,7 @@ same_set "nelf.1 OPTIONS" "$(help_options)" \
 for c in $commands; do
   same_set "nelf.1 $c options" "$(help_options "$c")" "$(section "$c" <"$page" | roff_options)"
   for p in $(help_positionals "$c"); do
-    section "$c" <"$page" | grep -qx "\\\\fI${p^^}\\\\fR" || fail "nelf.1 $c: positional ${p^^} not described"
+    section "$c" <"$page" | grep -x "\\\\fI${p^^}\\\\fR" >/dev/null || fail "nelf.1 $c: positional ${p^^} not described"
   done
 done
 # Rendered as lintian checks pages: no groff warning, no line that does not fit.
@@ -65,7 +67,7 @@ for c in $commands; do
   same_set "bash: nelf $c -<TAB>" "$(help_options "$c")" "$(bash_complete nelf "$c" -)"
 done
 [ "$(bash_complete nelf simulate --eye '')" = "$(printf 'left\nright')" ] || fail "bash: --eye values"
-bash_complete nelf convert --profile '' | grep -qx hmz-t1 || fail "bash: --profile does not offer the built-in profiles"
+bash_complete nelf convert --profile '' | grep -x hmz-t1 >/dev/null || fail "bash: --profile does not offer the built-in profiles"
 
 # ---- fish: ask fish itself (complete -C) ----
 if command -v fish >/dev/null; then

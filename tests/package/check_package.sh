@@ -36,7 +36,7 @@ done
 
 dpkg-deb -x "$deb" "$work/root"
 for elf in usr/bin/nelf usr/lib/nelf/nelf-oiio.so; do
-  file -b "$work/root/$elf" | grep -q ', stripped' || fail "$elf is not stripped: $(file -b "$work/root/$elf")"
+  file -b "$work/root/$elf" | grep ', stripped' >/dev/null || fail "$elf is not stripped: $(file -b "$work/root/$elf")"
   if [ -n "$dbgsym" ]; then
     id=$(readelf -n "$work/root/$elf" | sed -n 's/.*Build ID: //p')
     grep -q "usr/lib/debug/.build-id/${id:0:2}/${id:2}.debug" <<<"$(dpkg-deb -c "$dbgsym")" ||
