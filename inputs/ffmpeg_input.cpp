@@ -67,6 +67,10 @@ int open_input(FormatContextPtr& format, const std::string& path, NetworkGuard& 
     raw->interrupt_callback = AVIOInterruptCB{stop_after_refusal, &guard};
     // Kept as the second line of defence, and for what reaches FFmpeg without io_open.
     av_dict_set(&raw_options, "protocol_whitelist", "file,pipe", 0);
+    // A local HLS playlist without #EXT-X-ENDLIST is "live": while it lists nothing that opens,
+    // FFmpeg reloads it every target duration up to m3u8_hold_counters (1000) times. Nothing else
+    // writes to it while nelf reads (found by fuzzing): give up after two reloads that bring nothing.
+    av_dict_set(&raw_options, "m3u8_hold_counters", "2", 0);
   }
   const int opened = avformat_open_input(&raw, url.c_str(), nullptr, &raw_options);  // frees raw on failure
   DictionaryPtr unused(raw_options);

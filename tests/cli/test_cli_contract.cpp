@@ -104,6 +104,9 @@ TEST(CliContract, PlaylistWithNetworkSegmentsNamesAllowNetwork) {
   write_file(dir / "live.m3u8", "#EXTM3U\n#EXT-X-TARGETDURATION:1\n#EXTINF:1,\nhttp://127.0.0.1:9/a.ts\n");
   expect_clean_failure(dir, "probe " + q(dir / "live.m3u8"), 1,
                        "live.m3u8: opening it needs network access (http); pass --allow-network");
+  // The same for a local live playlist whose segment does not open: two reloads, not 1000.
+  write_file(dir / "local-live.m3u8", "#EXTM3U\n#EXT-X-TARGETDURATION:1\n#EXTINF:1,\nmissing.ts\n");
+  expect_clean_failure(dir, "probe " + q(dir / "local-live.m3u8"), 1, "local-live.m3u8: not a media file");
   expect_clean_failure(dir, "probe http://127.0.0.1:9/film.mkv", 1,
                        "needs network access (http); pass --allow-network");
   EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(30));
