@@ -54,11 +54,12 @@ class SourcePacketCarrier {
   SourcePacketCarrier(const std::string& path, double origin_s, bool allow_network) : origin_s_(origin_s) {
     network_.allow_network = allow_network;
     const int opened = ffmpeg::open_input(format_, path, network_);
-    if (!network_.refused_protocol.empty()) throw UserError(ffmpeg::network_refusal(path, network_), 1);
+    if (const auto stopped = ffmpeg::guard_stop(path, network_)) throw UserError(*stopped, 1);
     if (opened < 0)
       throw UserError(fmt::format("{}: cannot reopen for audio: {}", path, ffmpeg::error_string(opened)), 1);
-    if (avformat_find_stream_info(format_.get(), nullptr) < 0)
-      throw UserError(fmt::format("{}: cannot read stream information", path), 1);
+    const int found = ffmpeg::find_stream_info(format_.get(), network_);
+    if (const auto stopped = ffmpeg::guard_stop(path, network_)) throw UserError(*stopped, 1);
+    if (found < 0) throw UserError(fmt::format("{}: cannot read stream information", path), 1);
     if (origin_s > format_->start_time / static_cast<double>(AV_TIME_BASE) + 0.001)
       av_seek_frame(format_.get(), -1, static_cast<std::int64_t>(origin_s * AV_TIME_BASE), AVSEEK_FLAG_BACKWARD);
   }
@@ -97,7 +98,7 @@ class SourcePacketCarrier {
   }
 
  private:
-  ffmpeg::NetworkGuard network_;  // before `format_`: the context points at it while it lives
+  ffmpeg::InputGuard network_;  // before `format_`: the context points at it while it lives
   ffmpeg::FormatContextPtr format_;
   ffmpeg::PacketPtr packet_;
   double origin_s_;

@@ -29,7 +29,7 @@ using SwrContextPtr = std::unique_ptr<SwrContext, SwrContextDeleter>;
 struct AudioSource::Impl {
   std::string path;
   AudioSourceOptions options;
-  ffmpeg::NetworkGuard network;  // before `format`: the context points at it while it lives
+  ffmpeg::InputGuard network;  // before `format`: the context points at it while it lives
   ffmpeg::FormatContextPtr format;
   ffmpeg::CodecContextPtr codec;
   ffmpeg::PacketPtr packet{av_packet_alloc()};
@@ -51,10 +51,10 @@ struct AudioSource::Impl {
     // The same rule as VideoSource (DESIGN.md §11): no network unless asked for.
     network.allow_network = options.allow_network;
     const int opened = ffmpeg::open_input(format, path, network);
-    if (!network.refused_protocol.empty()) throw AudioError(ffmpeg::network_refusal(path, network));
+    if (const auto stopped = ffmpeg::guard_stop(path, network)) throw AudioError(*stopped);
     if (opened < 0) fail(fmt::format("cannot open: {}", ffmpeg::error_string(opened)));
-    const int found = avformat_find_stream_info(format.get(), nullptr);
-    if (!network.refused_protocol.empty()) throw AudioError(ffmpeg::network_refusal(path, network));
+    const int found = ffmpeg::find_stream_info(format.get(), network);
+    if (const auto stopped = ffmpeg::guard_stop(path, network)) throw AudioError(*stopped);
     if (found < 0) fail(fmt::format("not a readable media file: {}", ffmpeg::error_string(found)));
     const AVCodec* decoder = nullptr;
     const int best = av_find_best_stream(format.get(), AVMEDIA_TYPE_AUDIO, -1, -1, &decoder, 0);

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <cstring>
 
@@ -30,7 +32,7 @@ bool is_local_protocol(const char* protocol) {
 // for a playlist: this records which protocol was refused, so the user is told what to pass.
 int guarded_io_open(AVFormatContext* context, AVIOContext** pb, const char* url, int flags, AVDictionary** options) {
   // A nested demuxer's context may have copied io_open but not opaque: the whitelist still holds.
-  auto* guard = static_cast<NetworkGuard*>(context->opaque);
+  auto* guard = static_cast<InputGuard*>(context->opaque);
   if (guard != nullptr && !guard->allow_network) {
     const char* protocol = avio_find_protocol_name(url);
     if (!is_local_protocol(protocol)) {
@@ -43,16 +45,28 @@ int guarded_io_open(AVFormatContext* context, AVIOContext** pb, const char* url,
 
 // Once a URL was refused there is nothing left to wait for: a live HLS playlist (no #EXT-X-ENDLIST)
 // whose segments are refused would otherwise be reloaded every target duration, up to
-// m3u8_hold_counters (1000) times, before opening gives up (~17 min for 1 s segments).
-int stop_after_refusal(void* opaque) {
-  return static_cast<const NetworkGuard*>(opaque)->refused_protocol.empty() ? 0 : 1;
+// m3u8_hold_counters (1000) times, before opening gives up (~17 min for 1 s segments). FFmpeg
+// calls this at least every 100 ms while it waits.
+int interrupt_when_stopped(void* opaque) {
+  auto* guard = static_cast<InputGuard*>(opaque);
+  if (!guard->refused_protocol.empty()) return 1;
+  if (guard->opening_deadline && std::chrono::steady_clock::now() >= *guard->opening_deadline) {
+    guard->opening_stopped = true;
+    return 1;
+  }
+  return 0;
+}
+
+bool is_regular_file(const std::string& path) {
+  struct stat info {};
+  return ::stat(path.c_str(), &info) == 0 && S_ISREG(info.st_mode);
 }
 
 }  // namespace
 
 bool is_url(const std::string& path) { return path.find("://") != std::string::npos || path.rfind("pipe:", 0) == 0; }
 
-int open_input(FormatContextPtr& format, const std::string& path, NetworkGuard& guard) {
+int open_input(FormatContextPtr& format, const std::string& path, InputGuard& guard) {
   const std::string url = is_url(path) ? path : "file:" + path;
   AVFormatContext* raw = avformat_alloc_context();
   if (raw == nullptr) return AVERROR(ENOMEM);
@@ -64,7 +78,9 @@ int open_input(FormatContextPtr& format, const std::string& path, NetworkGuard& 
     }
     raw->opaque = &guard;
     raw->io_open = guarded_io_open;
-    raw->interrupt_callback = AVIOInterruptCB{stop_after_refusal, &guard};
+    raw->interrupt_callback = AVIOInterruptCB{interrupt_when_stopped, &guard};
+    if (!is_url(path) && is_regular_file(path))
+      guard.opening_deadline = std::chrono::steady_clock::now() + guard.opening_limit;
     // Kept as the second line of defence, and for what reaches FFmpeg without io_open.
     av_dict_set(&raw_options, "protocol_whitelist", "file,pipe", 0);
     // A local HLS playlist without #EXT-X-ENDLIST is "live": while it lists nothing that opens,
@@ -78,8 +94,20 @@ int open_input(FormatContextPtr& format, const std::string& path, NetworkGuard& 
   return opened;
 }
 
-std::string network_refusal(const std::string& path, const NetworkGuard& guard) {
-  return fmt::format("{}: opening it needs network access ({}); pass --allow-network", path, guard.refused_protocol);
+int find_stream_info(AVFormatContext* format, InputGuard& guard, AVDictionary** options) {
+  const int found = avformat_find_stream_info(format, options);
+  guard.opening_deadline.reset();
+  return found;
+}
+
+std::optional<std::string> guard_stop(const std::string& path, const InputGuard& guard) {
+  if (!guard.refused_protocol.empty())
+    return fmt::format("{}: opening it needs network access ({}); pass --allow-network", path, guard.refused_protocol);
+  if (guard.opening_stopped)
+    return fmt::format(
+        "{}: still not open after {:g} s, given up (a live playlist whose entries do not open?); check what it lists",
+        path, std::chrono::duration<double>(guard.opening_limit).count());
+  return std::nullopt;
 }
 
 }  // namespace nelf::ffmpeg

@@ -211,7 +211,7 @@ void copy_rotated(const uint8_t* src, int src_stride_bytes, int width, int heigh
 struct VideoSource::Impl {
   VideoInfo info;
   VideoSourceOptions options;
-  NetworkGuard network;  // before `format`: the context points at it while it lives
+  InputGuard network;  // before `format`: the context points at it while it lives
   FormatContextPtr format;
   CodecContextPtr codec;
   AVStream* stream = nullptr;
@@ -261,7 +261,7 @@ struct VideoSource::Impl {
     // Playlists (HLS, concat, …) can otherwise make FFmpeg fetch URLs (DESIGN.md §11).
     network.allow_network = options.allow_network;
     const int opened = open_input(format, path, network);
-    if (!network.refused_protocol.empty()) throw VideoError(network_refusal(path, network));
+    if (const auto stopped = guard_stop(path, network)) throw VideoError(*stopped);
     if (opened < 0) {
       if (opened == AVERROR_INVALIDDATA) fail("not a media file FFmpeg can read");
       if (opened == AVERROR(EACCES)) fail("permission denied");
@@ -283,10 +283,10 @@ struct VideoSource::Impl {
     const std::string max_pixels = std::to_string(options.max_pixels);
     std::vector<AVDictionary*> probe_options(format->nb_streams, nullptr);
     for (AVDictionary*& o : probe_options) av_dict_set(&o, "max_pixels", max_pixels.c_str(), 0);
-    const int found = avformat_find_stream_info(format.get(), probe_options.empty() ? nullptr : probe_options.data());
+    const int found = find_stream_info(format.get(), network, probe_options.empty() ? nullptr : probe_options.data());
     for (AVDictionary*& o : probe_options) av_dict_free(&o);
     // Some demuxers open what a playlist names only when probing the streams.
-    if (!network.refused_protocol.empty()) throw VideoError(network_refusal(path, network));
+    if (const auto stopped = guard_stop(path, network)) throw VideoError(*stopped);
     if (found < 0) fail(fmt::format("not a readable media file: {}", error_string(found)));
 
     for (unsigned i = 0; i < format->nb_streams; ++i)

@@ -107,9 +107,14 @@ TEST(CliContract, PlaylistWithNetworkSegmentsNamesAllowNetwork) {
   // The same for a local live playlist whose segment does not open: two reloads, not 1000.
   write_file(dir / "local-live.m3u8", "#EXTM3U\n#EXT-X-TARGETDURATION:1\n#EXTINF:1,\nmissing.ts\n");
   expect_clean_failure(dir, "probe " + q(dir / "local-live.m3u8"), 1, "local-live.m3u8: not a media file");
+  // Each reload of a live playlist waits its target duration: opening a local file is given up
+  // after 15 s (it waited 2 x 100 s before).
+  write_file(dir / "slow-live.m3u8", "#EXTM3U\n#EXT-X-TARGETDURATION:100\n#EXTINF:100,\nmissing.ts\n");
+  expect_clean_failure(dir, "probe " + q(dir / "slow-live.m3u8"), 1,
+                       "slow-live.m3u8: still not open after 15 s, given up");
   expect_clean_failure(dir, "probe http://127.0.0.1:9/film.mkv", 1,
                        "needs network access (http); pass --allow-network");
-  EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(30));
+  EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(45));
 }
 
 // --quiet hides progress, not warnings: a 2D clip still says it is shown as 2D.

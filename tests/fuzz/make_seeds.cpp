@@ -143,6 +143,10 @@ void make_seeds(const fs::path& out, const fs::path& profiles) {
   s.seed("video", "avi-mpeg4", '\x05', s.media("a.avi", picture("32x16", 2) + " -c:v mpeg4"));
   s.seed("video", "h264-10bit", '\x06',
          s.media("b.h264", picture("32x16", 2) + " -c:v libx264 -preset ultrafast -pix_fmt yuv420p10le -f h264"));
+  // A playlist with a network segment: with the network guard on it must be refused, not fetched.
+  // Live variants of it (no #EXT-X-ENDLIST, a long target duration) must be given up, not waited on.
+  s.seed("video", "hls-http", '\0',
+         "#EXTM3U\n#EXT-X-TARGETDURATION:1\n#EXTINF:1,\nhttp://127.0.0.1:9/a.ts\n#EXT-X-ENDLIST\n");
   s.seed("video", "webm-vp8", '\x07', s.media("a.webm", picture("32x16", 2) + " -c:v libvpx"));
   fs::remove_all(scratch);
 }
