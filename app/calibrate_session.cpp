@@ -11,11 +11,11 @@
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
 #include "app/live_display.hpp"
-#include "compositor/calibration_controls.hpp"
-#include "compositor/gl_compositor.hpp"
-#include "compositor/text_overlay.hpp"
+#include "player/calibration_controls.hpp"
+#include "compositor/gl/gl_compositor.hpp"
+#include "compositor/overlays/text_overlay.hpp"
 #include "hmz_output/packing.hpp"
-#include "inputs/printable.hpp"
+#include "core/printable.hpp"
 
 namespace nelf::app {
 

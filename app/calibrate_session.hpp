@@ -4,7 +4,7 @@
 #include <string>
 
 #include "compositor/compositor.hpp"
-#include "compositor/profile.hpp"
+#include "optics/profile.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/signal.hpp"
 #include "inputs/test_patterns.hpp"

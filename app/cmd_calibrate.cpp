@@ -1,5 +1,5 @@
 // `nelf calibrate`: test patterns drawn through the compositor, with keys that tune the profile's
-// calibration live (compositor/calibration_controls) and --save to keep the result; or, with
+// calibration live (player/calibration_controls) and --save to keep the result; or, with
 // --pattern and an image file as --output, the packed pattern frame written headless like a still
 // converted by `nelf convert`.
 #include <fmt/format.h>
@@ -14,8 +14,8 @@
 #include "app/calibrate_session.hpp"
 #include "app/commands.hpp"
 #include "app/input_files.hpp"
-#include "compositor/calibration_controls.hpp"
-#include "compositor/profile.hpp"
+#include "player/calibration_controls.hpp"
+#include "optics/profile.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "inputs/test_patterns.hpp"

@@ -6,9 +6,9 @@
 
 #include "app/commands.hpp"
 #include "app/input_files.hpp"
-#include "compositor/design.hpp"
-#include "compositor/design_plot.hpp"
-#include "compositor/profile.hpp"
+#include "optics/design.hpp"
+#include "analysis/design_plot.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf::app {
 

@@ -1,5 +1,5 @@
 // `nelf play IN`: watch a stereo video on the HMD (or a preview window) with sound: the player
-// engine (hmz_output/player) on the display --output picks.
+// engine (player/player) on the display --output picks.
 #include <fmt/format.h>
 
 #include <cstdlib>
@@ -10,8 +10,8 @@
 #include "app/interrupt.hpp"
 #include "app/live_display.hpp"
 #include "hmz_output/display.hpp"
-#include "hmz_output/player.hpp"
-#include "inputs/printable.hpp"
+#include "player/player.hpp"
+#include "core/printable.hpp"
 #include "inputs/stereo_frame_source.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/video_source.hpp"

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "app/commands.hpp"
-#include "inputs/printable.hpp"
+#include "core/printable.hpp"
 #include "inputs/stereo_layout.hpp"
 #include "inputs/video_source.hpp"
 

@@ -2,7 +2,7 @@
 #include <fmt/format.h>
 
 #include "app/commands.hpp"
-#include "compositor/profile.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf::app {
 

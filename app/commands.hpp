@@ -7,16 +7,16 @@
 #include <string>
 
 #include "compositor/compositor.hpp"
-#include "compositor/profile.hpp"
+#include "optics/profile.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/signal.hpp"
-#include "inputs/pixel_limit.hpp"
+#include "core/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
-#include "inputs/user_error.hpp"
+#include "core/user_error.hpp"
 
 namespace nelf::app {
 
-// See inputs/user_error.hpp: main() prints what() as one line and exits with status().
+// See core/user_error.hpp: main() prints what() as one line and exits with status().
 using nelf::UserError;
 
 // The --layout option of convert and simulate: "auto" (nullopt: detect) or a layout name.

@@ -1,5 +1,5 @@
 #include "app/convert_video.hpp"
-#include "inputs/printable.hpp"
+#include "core/printable.hpp"
 
 #include <fmt/format.h>
 #include <fmt/printf.h>
@@ -21,15 +21,15 @@ extern "C" {
 
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
-#include "compositor/composite_table_cache.hpp"
-#include "compositor/gl/egl_context.hpp"
-#include "compositor/gl_compositor.hpp"
+#include "compositor/cpu/composite_table_cache.hpp"
+#include "core/gl/egl_context.hpp"
+#include "compositor/gl/gl_compositor.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
-#include "hmz_output/progress.hpp"
-#include "inputs/bounded_queue.hpp"
+#include "player/progress.hpp"
+#include "core/bounded_queue.hpp"
 #include "inputs/ffmpeg_input.hpp"
-#include "inputs/ffmpeg_raii.hpp"
+#include "core/ffmpeg_raii.hpp"
 #include "inputs/stereo_frame_source.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
@@ -273,7 +273,7 @@ class PackedFrameRenderer {
                                          area->y + (area->height - panel[1]) / 2};
     }
     // On a software rasteriser 8-bit block means are composited on the CPU from tables recorded
-    // once with the compositor's shaders (compositor/composite_table.hpp): several times cheaper
+    // once with the compositor's shaders (compositor/cpu/composite_table.hpp): several times cheaper
     // than llvmpipe's passes. Tables seen before come from the cache without starting GL at all.
     const CompositeTableCache cache;
     if (bits == 8 && tables_from_cache(r, cache, aspect)) return;

@@ -5,10 +5,10 @@
 
 #include "app/input_files.hpp"
 #include "compositor/compositor.hpp"
-#include "compositor/profile.hpp"
+#include "optics/profile.hpp"
 #include "hmz_output/signal.hpp"
 #include "hmz_output/video_encoder.hpp"
-#include "inputs/pixel_limit.hpp"
+#include "core/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
 
 namespace nelf::app {

@@ -8,8 +8,8 @@
 #include <system_error>
 
 #include "app/commands.hpp"
-#include "compositor/chart_style.hpp"
-#include "compositor/image_library.hpp"
+#include "core/chart_style.hpp"
+#include "core/image_library.hpp"
 #include "hmz_output/image_sink.hpp"
 
 namespace nelf::app {

@@ -6,7 +6,7 @@
 #include <system_error>
 
 #include "inputs/synthetic_source.hpp"
-#include "inputs/user_error.hpp"
+#include "core/user_error.hpp"
 
 namespace nelf::app {
 namespace {

@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "compositor/profile.hpp"
+#include "optics/profile.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/signal.hpp"
 

@@ -9,8 +9,8 @@
 
 #include "app/cli_suggestions.hpp"
 #include "app/commands.hpp"
-#include "compositor/profile.hpp"
-#include "inputs/printable.hpp"
+#include "optics/profile.hpp"
+#include "core/printable.hpp"
 
 namespace {
 

@@ -4,8 +4,8 @@
 #include <array>
 #include <optional>
 
-#include "compositor/image.hpp"
-#include "compositor/profile.hpp"
+#include "core/image.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf {
 
@@ -20,8 +20,6 @@ struct CompositorOptions {
 
 // Throws std::invalid_argument naming the allowed values when `fsaa` is not 0, 1, 4 or 16.
 void validate_fsaa(int fsaa);
-
-using EyeImages = std::array<Image, 2>;  // indexed by Eye
 
 class Compositor {
  public:

@@ -1,6 +1,6 @@
 #include "compositor/make_compositor.hpp"
 
-#include "compositor/gl_compositor.hpp"
+#include "compositor/gl/gl_compositor.hpp"
 
 namespace nelf {
 

@@ -3,7 +3,7 @@
 #include <memory>
 
 #include "compositor/compositor.hpp"
-#include "compositor/profile.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf {
 

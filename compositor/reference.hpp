@@ -4,7 +4,7 @@
 // owns its position), each a bilinear tap on the full-resolution view. Slow by design; it is the
 // oracle the GL path is tested against.
 #include "compositor/compositor.hpp"
-#include "compositor/mapping.hpp"
+#include "optics/mapping.hpp"
 
 namespace nelf {
 

@@ -15,7 +15,7 @@
 #include <optional>
 #include <string>
 
-#include "inputs/audio_source.hpp"
+#include "core/frames.hpp"
 
 namespace nelf {
 

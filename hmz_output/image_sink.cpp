@@ -16,7 +16,7 @@
 #include <system_error>
 #include <vector>
 
-#include "compositor/image_library.hpp"
+#include "core/image_library.hpp"
 
 namespace nelf {
 namespace {

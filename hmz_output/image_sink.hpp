@@ -1,13 +1,13 @@
 #pragma once
-// The image-file sink: writes one output frame with OpenImageIO (compositor/image_library.hpp), format by extension
+// The image-file sink: writes one output frame with OpenImageIO (core/image_library.hpp), format by extension
 // (.png, .tif, .tiff, .exr, .jpg, .jpeg). The file appears complete or not at all: it is written under a temporary name
 // in the same directory and renamed at the end (DESIGN.md §11).
 #include <filesystem>
 #include <functional>
 #include <stdexcept>
 
-#include "compositor/image.hpp"
-#include "compositor/image_library.hpp"
+#include "core/image.hpp"
+#include "core/image_library.hpp"
 
 namespace nelf {
 

@@ -21,8 +21,8 @@
 #include <set>
 #include <string_view>
 
-#include "compositor/gl/egl_context.hpp"
-#include "compositor/gl/objects.hpp"
+#include "core/gl/egl_context.hpp"
+#include "core/gl/objects.hpp"
 #include "hmz_output/kms_modes.hpp"
 #include "hmz_output/terminal_keys.hpp"
 

@@ -3,8 +3,9 @@
 #include <optional>
 #include <stdexcept>
 
-#include "compositor/compositor.hpp"
+#include "core/image.hpp"
 #include "hmz_output/signal.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf {
 

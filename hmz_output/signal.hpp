@@ -7,8 +7,8 @@
 #include <string_view>
 #include <vector>
 
-#include "compositor/image.hpp"
-#include "compositor/profile.hpp"
+#include "core/image.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf {
 

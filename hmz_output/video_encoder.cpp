@@ -1,7 +1,7 @@
 #include "hmz_output/video_encoder.hpp"
 
 #include "hmz_output/rgba_to_yuv.hpp"
-#include "inputs/ffmpeg_raii.hpp"
+#include "core/ffmpeg_raii.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>

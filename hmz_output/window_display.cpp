@@ -13,8 +13,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "compositor/gl/egl_context.hpp"
-#include "compositor/gl/objects.hpp"
+#include "core/gl/egl_context.hpp"
+#include "core/gl/objects.hpp"
 #include "hmz_output/glfw_x11.hpp"
 #include "hmz_output/monitor_selection.hpp"
 #include "hmz_output/packing.hpp"

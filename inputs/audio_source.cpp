@@ -13,7 +13,7 @@ extern "C" {
 }
 
 #include "inputs/ffmpeg_input.hpp"
-#include "inputs/ffmpeg_raii.hpp"
+#include "core/ffmpeg_raii.hpp"
 
 namespace nelf {
 

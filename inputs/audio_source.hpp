@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "core/frames.hpp"
+
 namespace nelf {
 
 // The audio cannot be opened or decoded at all; what() is one line naming the file and the cause.
@@ -22,13 +24,6 @@ struct AudioSourceOptions {
   int sample_rate = 48000;     // of the delivered samples
   double origin_s = 0.0;       // container time that becomes pts 0 (the video's origin)
   bool allow_network = false;  // false: FFmpeg may only use the file and pipe protocols
-};
-
-// Interleaved stereo float samples (L R L R …), −1..1.
-struct AudioChunk {
-  double pts_s = 0.0;  // time of the first sample
-  std::vector<float> samples;
-  std::int64_t frames() const { return static_cast<std::int64_t>(samples.size() / 2); }
 };
 
 class AudioSource {

@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "inputs/ffmpeg_raii.hpp"
+#include "core/ffmpeg_raii.hpp"
 
 namespace nelf::ffmpeg {
 

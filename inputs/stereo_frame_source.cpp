@@ -1,5 +1,5 @@
 #include "inputs/stereo_frame_source.hpp"
-#include "inputs/printable.hpp"
+#include "core/printable.hpp"
 
 #include <fmt/format.h>
 
@@ -9,7 +9,7 @@
 #include <utility>
 
 #include "inputs/synthetic_source.hpp"
-#include "inputs/user_error.hpp"
+#include "core/user_error.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
 

@@ -11,30 +11,16 @@
 #include <string>
 #include <vector>
 
-#include "inputs/pixel_limit.hpp"
+#include "core/frames.hpp"
+#include "core/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
 
 namespace nelf {
-
-// Both views of one stereo frame, as tightly packed RGBA of `bits` per channel (8: one byte per
-// channel; 16: native-endian uint16 per channel): width×height pixels, or, when `block` is more
-// than 1×1, (width / block[0])×(height / block[1]) means of block[0]×block[1] pixels each (made
-// while converting from YUV, see StereoFrameSource::reduce_views). width, height and aspect are
-// always those of the full view.
-struct StereoVideoFrame {
-  int width = 0, height = 0, bits = 8;
-  std::vector<std::uint8_t> left, right;
-  double aspect = 0.0;
-  double pts_s = 0.0;  // time from origin_s(): from 0 at the start (or the requested start)
-  std::array<int, 2> block{1, 1};
-};
 
 // Which block of pixels the caller wants averaged into each delivered pixel of a view of
 // `view_width`×`view_height` pixels shown at `aspect` ({1, 1}: whole views). The caller decides
 // (e.g. the compositor's prefilter_block for both eyes); the source only honours it.
 using ViewBlockChooser = std::function<std::array<int, 2>(int view_width, int view_height, double aspect)>;
-
-inline std::size_t bytes_per_pixel(int bits) { return bits > 8 ? 8 : 4; }
 
 struct StereoSourceRequest {
   std::string input;                   // a media file or `synthetic:[options]`

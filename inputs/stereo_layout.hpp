@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "compositor/image.hpp"
+#include "core/image.hpp"
 #include "inputs/stereo_metadata.hpp"
 
 namespace nelf {

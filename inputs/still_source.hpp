@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "compositor/image.hpp"
-#include "inputs/pixel_limit.hpp"
+#include "core/image.hpp"
+#include "core/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
 
 namespace nelf {
@@ -29,7 +29,7 @@ constexpr int kMaxImageDimension = 16384;
 // Reads the first image of a file as float RGBA 0..1 (gray -> r=g=b, missing alpha -> 1; 8-, 16-bit
 // and float sources). `.jps` files are read as JPEG. Throws StillError for missing, unreadable,
 // corrupt or truncated files and for zero or over-large dimensions, or more than `max_pixels`
-// pixels (checked from the header, before decoding: inputs/pixel_limit.hpp).
+// pixels (checked from the header, before decoding: core/pixel_limit.hpp).
 Image read_image_file(const std::filesystem::path& path, std::int64_t max_pixels = kDefaultMaxPixels);
 
 // The same for an encoded image held in memory (e.g. the second JPEG of an MPO). `format` is an

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "compositor/image.hpp"
+#include "core/image.hpp"
 
 namespace nelf {
 

@@ -7,10 +7,10 @@
 #include <cmath>
 #include <numbers>
 
-#include "compositor/chart_style.hpp"
-#include "compositor/image_library.hpp"
-#include "compositor/mapping.hpp"
-#include "compositor/optics.hpp"
+#include "core/chart_style.hpp"
+#include "core/image_library.hpp"
+#include "optics/mapping.hpp"
+#include "optics/optics.hpp"
 
 namespace nelf {
 

@@ -16,8 +16,8 @@
 #include <string_view>
 #include <vector>
 
-#include "compositor/image.hpp"
-#include "compositor/profile.hpp"
+#include "core/image.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf {
 
@@ -50,7 +50,7 @@ struct PatternGeometry {
 };
 
 // The geometry of `profile`'s virtual screen for views of `width`×`height` (display aspect
-// width/height): the lens-array mapping's screen (compositor/mapping), or for a stock device the
+// width/height): the lens-array mapping's screen (optics/mapping), or for a stock device the
 // panel magnified by its [magnifier] (screen width unknown without one). Stripes are three display
 // pixels wide, grid lines one display pixel, 16 grid cells across.
 PatternGeometry pattern_geometry(const Profile& profile, int width = 1920, int height = 1080);

@@ -9,7 +9,7 @@
 #include <string_view>
 
 #include "inputs/ffmpeg_input.hpp"
-#include "inputs/ffmpeg_raii.hpp"
+#include "core/ffmpeg_raii.hpp"
 #include "inputs/yuv_block_means.hpp"
 
 extern "C" {
@@ -243,7 +243,7 @@ struct VideoSource::Impl {
 
   [[noreturn]] void fail(const std::string& what) const { throw VideoError(fmt::format("{}: {}", info.path, what)); }
 
-  // Refuses frames over --max-pixels (inputs/pixel_limit.hpp); `where` says which (" in the stream").
+  // Refuses frames over --max-pixels (core/pixel_limit.hpp); `where` says which (" in the stream").
   void check_pixel_limit(int width, int height, std::string_view where) const {
     if (const auto problem = pixel_limit_problem(width, height, options.max_pixels))
       fail(fmt::format("video frames{}: {}", where, *problem));

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "compositor/image.hpp"
-#include "inputs/pixel_limit.hpp"
+#include "core/image.hpp"
+#include "core/pixel_limit.hpp"
 #include "inputs/stereo_metadata.hpp"
 
 namespace nelf {

@@ -1,6 +1,6 @@
 #version 450 core
 // One eye's elemental images: the per-pixel mapping of DESIGN.md §3, the same math as
-// compositor/mapping.cpp (view_coordinate) in float. Pixel positions are taken relative to the
+// optics/mapping.cpp (view_coordinate) in float. Pixel positions are taken relative to the
 // panel's pixel grid, so float keeps sub-micrometre precision.
 //
 // Compiled twice: as is for pass 1 (point samples over the whole region), and with
@@ -90,7 +90,7 @@ vec3 point_sample(vec2 pixel) {
 
 #ifdef NELF_RECORD_TAPS
 // Where each part of a border pixel taps u_view and with what weight (x, y, weight, 1), instead of
-// tapping: the CPU composite table (compositor/composite_table.hpp) replays them every frame.
+// tapping: the CPU composite table (compositor/cpu/composite_table.hpp) replays them every frame.
 // Part 0 is the own lens, 1 the neighbour across x, 2 across y, 3 the diagonal one; weight 0 for a
 // part that is absent or falls on a black lens.
 vec4 recorded[4] = vec4[4](vec4(0.0, 0.0, 0.0, 1.0), vec4(0.0, 0.0, 0.0, 1.0), vec4(0.0, 0.0, 0.0, 1.0),

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
-#include "compositor/profile.hpp"
+#include "optics/profile.hpp"
 
 namespace {
 

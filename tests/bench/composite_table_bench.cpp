@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "bench/bench_timing.hpp"
-#include "compositor/gl_compositor.hpp"
+#include "compositor/gl/gl_compositor.hpp"
 
 namespace {
 

@@ -21,7 +21,7 @@ export LP_NUM_THREADS=${LP_NUM_THREADS:-$(nproc)}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export MESA_SHADER_CACHE_DIR=$work/shader-cache
-export NELF_CACHE_DIR=$work/nelf-cache  # composite tables (compositor/composite_table_cache.hpp)
+export NELF_CACHE_DIR=$work/nelf-cache  # composite tables (compositor/cpu/composite_table_cache.hpp)
 case $layout in
   half) clip=$work/clip.hsbs.mkv eye=960x1080 frame=1920x1080 ;;  # "hsbs": detected from the name
   full) clip=$work/clip.sbs.mkv eye=1920x1080 frame=3840x1080 ;;

@@ -1,4 +1,4 @@
-// OpenImageIO as a module loaded on first use (compositor/image_library.hpp): commands that read or
+// OpenImageIO as a module loaded on first use (core/image_library.hpp): commands that read or
 // write no image file run without it, and one that needs it but cannot load it fails with one
 // clear line and leaves nothing behind.
 #include <gtest/gtest.h>

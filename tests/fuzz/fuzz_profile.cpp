@@ -1,4 +1,4 @@
-// Fuzz target: the profile parser and validator (compositor/profile.*), the input's bytes taken as
+// Fuzz target: the profile parser and validator (optics/profile.*), the input's bytes taken as
 // the TOML text of a profile file. A profile is refused with ProfileError (one line) or accepted; an
 // accepted one must also survive its own serialisation, as profile_to_toml promises.
 #include <cstddef>
@@ -8,7 +8,7 @@
 #include <string>
 #include <string_view>
 
-#include "compositor/profile.hpp"
+#include "optics/profile.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

@@ -19,7 +19,7 @@ extern "C" {
 #include <optional>
 #include <span>
 
-#include "inputs/ffmpeg_raii.hpp"
+#include "core/ffmpeg_raii.hpp"
 #include "inputs/stereo_metadata.hpp"
 
 namespace {

@@ -10,7 +10,7 @@
 #include <span>
 #include <string>
 
-#include "compositor/image_library.hpp"
+#include "core/image_library.hpp"
 #include "inputs/still_source.hpp"
 #include "temp_input.hpp"
 

@@ -4,9 +4,9 @@
 #include <memory>
 #include <string>
 
-#include "compositor/gl/egl_context.hpp"
-#include "compositor/image.hpp"
-#include "compositor/profile.hpp"
+#include "core/gl/egl_context.hpp"
+#include "core/image.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf::test {
 

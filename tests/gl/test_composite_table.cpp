@@ -1,4 +1,4 @@
-// The CPU composite table (compositor/composite_table.hpp) against the GL path it replays:
+// The CPU composite table (compositor/cpu/composite_table.hpp) against the GL path it replays:
 // render_eye_reduced from the same RGBA8 block means into an RGBA8 target, read back as bytes.
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "compositor/gl_compositor.hpp"
+#include "compositor/gl/gl_compositor.hpp"
 #include "gl/gl_test_support.hpp"
 
 namespace nelf {

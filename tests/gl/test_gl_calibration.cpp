@@ -7,7 +7,7 @@
 #include <functional>
 #include <string>
 
-#include "compositor/gl_compositor.hpp"
+#include "compositor/gl/gl_compositor.hpp"
 #include "compositor/reference.hpp"
 #include "gl/gl_test_support.hpp"
 

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "compositor/gl_compositor.hpp"
+#include "compositor/gl/gl_compositor.hpp"
 #include "compositor/reference.hpp"
 #include "gl/gl_test_support.hpp"
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "compositor/image.hpp"
+#include "core/image.hpp"
 #include "support/test_support.hpp"
 
 namespace nelf::test {

@@ -2,8 +2,8 @@
 // would be saved loads back with the adjusted values.
 #include <gtest/gtest.h>
 
-#include "compositor/calibration_controls.hpp"
-#include "compositor/mapping.hpp"
+#include "player/calibration_controls.hpp"
+#include "optics/mapping.hpp"
 #include "compositor/reference.hpp"
 #include "support/test_support.hpp"
 

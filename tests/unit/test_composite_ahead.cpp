@@ -1,4 +1,4 @@
-// Compositing ahead (hmz_output/composite_ahead): a packed frame is handed out only for the frame
+// Compositing ahead (compositor/cpu/composite_ahead): a packed frame is handed out only for the frame
 // and the very setup it was made with; frames no longer wanted, made with an older setup or for
 // other views are never handed out; memory stays bounded; the worker stops cleanly while busy.
 // One-pixel eyes whose table shows the view's one pixel, so that the packed frame says which view
@@ -12,7 +12,7 @@
 #include <memory>
 #include <vector>
 
-#include "hmz_output/composite_ahead.hpp"
+#include "compositor/cpu/composite_ahead.hpp"
 
 namespace nelf {
 namespace {

@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "compositor/composite_table.hpp"
+#include "compositor/cpu/composite_table.hpp"
 
 namespace nelf {
 namespace {

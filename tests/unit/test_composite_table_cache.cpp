@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "compositor/composite_table_cache.hpp"
+#include "compositor/cpu/composite_table_cache.hpp"
 #include "support/test_support.hpp"
 
 namespace nelf {

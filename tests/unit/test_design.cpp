@@ -1,4 +1,4 @@
-// The design report (compositor/design.hpp) and the trade-space plot (compositor/design_plot.hpp).
+// The design report (optics/design.hpp) and the trade-space plot (analysis/design_plot.hpp).
 // Expected values come from DESIGN.md §2 (hmz-t1) and from the hand computations in test_optics.cpp.
 #include <gtest/gtest.h>
 
@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "compositor/design.hpp"
-#include "compositor/design_plot.hpp"
+#include "optics/design.hpp"
+#include "analysis/design_plot.hpp"
 #include "support/test_support.hpp"
 
 namespace nelf {

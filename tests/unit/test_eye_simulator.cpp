@@ -3,7 +3,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "compositor/eye_simulator.hpp"
+#include "analysis/eye_simulator.hpp"
 #include "compositor/reference.hpp"
 
 namespace nelf {

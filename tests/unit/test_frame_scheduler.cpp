@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "hmz_output/frame_scheduler.hpp"
+#include "player/frame_scheduler.hpp"
 
 namespace nelf {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "compositor/mapping.hpp"
+#include "optics/mapping.hpp"
 #include "compositor/reference.hpp"
 
 namespace nelf {

@@ -1,4 +1,4 @@
-// The formulas of DESIGN.md §2 (compositor/optics.hpp) against three geometries whose figures are
+// The formulas of DESIGN.md §2 (optics/optics.hpp) against three geometries whose figures are
 // known independently of the code: the hmz-t1 values in DESIGN.md's table, and two geometries worked
 // out by hand below (exact fractions where possible, so the expected values are not the code's own).
 #include <gtest/gtest.h>
@@ -7,7 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "compositor/optics.hpp"
+#include "optics/optics.hpp"
 
 namespace nelf::optics {
 namespace {

@@ -1,4 +1,4 @@
-#include "inputs/printable.hpp"
+#include "core/printable.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "compositor/profile.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf {
 namespace {

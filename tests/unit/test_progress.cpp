@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <thread>
 
-#include "hmz_output/progress.hpp"
-#include "inputs/bounded_queue.hpp"
+#include "player/progress.hpp"
+#include "core/bounded_queue.hpp"
 
 namespace nelf {
 namespace {

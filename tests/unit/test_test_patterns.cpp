@@ -5,8 +5,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "compositor/mapping.hpp"
-#include "compositor/profile.hpp"
+#include "optics/mapping.hpp"
+#include "optics/profile.hpp"
 #include "inputs/test_patterns.hpp"
 
 namespace nelf {

@@ -16,8 +16,8 @@
 #include <thread>
 #include <utility>
 
-#include "compositor/mapping.hpp"
-#include "compositor/profile.hpp"
+#include "optics/mapping.hpp"
+#include "optics/profile.hpp"
 #include "support/image_files.hpp"
 #include "support/test_support.hpp"
 #include "support/xvfb.hpp"

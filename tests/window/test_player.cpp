@@ -18,9 +18,9 @@
 #include <utility>
 #include <vector>
 
-#include "compositor/gl_compositor.hpp"
+#include "compositor/gl/gl_compositor.hpp"
 #include "hmz_output/packing.hpp"
-#include "hmz_output/player.hpp"
+#include "player/player.hpp"
 #include "hmz_output/window_display.hpp"
 #include "support/media.hpp"
 #include "support/test_support.hpp"
@@ -289,7 +289,7 @@ TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessag
   // in the GL run and into the views' bytes in the table run (TextOverlay::cover), eyes swapped
   // and the calibration grid drawn into the views' bytes too. Every frame both runs rendered (by
   // pts: a loaded machine may drop different ones) looks the same, text and grid included. The
-  // table run's frames are mostly composited ahead, on a worker (hmz_output/composite_ahead).
+  // table run's frames are mostly composited ahead, on a worker (compositor/cpu/composite_ahead).
   const auto clip = make_clip(dir_, 4);
   PlayerOptions options = silent_options();
   const auto wanted = stereo_prefilter_block(options.profile, options.compositor, 320, 180, 0.0);
@@ -424,7 +424,7 @@ class TypedKeysDisplay final : public Display {
 };
 
 TEST_F(PlayerWindowTest, NoFrameCompositedAheadShowsAStateAKeyHasChanged) {
-  // On the CPU path a worker composites the next queued frames ahead (hmz_output/composite_ahead)
+  // On the CPU path a worker composites the next queued frames ahead (compositor/cpu/composite_ahead)
   // with the state of the moment; a key changes that state while such frames wait. Without
   // on-screen messages (while one shows, GL draws the frames) the table path goes on right after
   // the key, so a frame made before it would be seen at once. The clip played on the table path

@@ -14,8 +14,8 @@
 #include <thread>
 #include <vector>
 
-#include "compositor/gl_compositor.hpp"
-#include "compositor/profile.hpp"
+#include "compositor/gl/gl_compositor.hpp"
+#include "optics/profile.hpp"
 #include "hmz_output/packing.hpp"
 #include "hmz_output/window_display.hpp"
 #include "support/x11_window.hpp"

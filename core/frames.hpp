@@ -1,0 +1,34 @@
+#pragma once
+// What flows between the stages for video: the two views of one stereo frame as the sources deliver
+// them, and the sound that goes with them. Here, below the stages, so that a source makes them and
+// the compositor and the outputs take them without including each other.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace nelf {
+
+// Both views of one stereo frame, as tightly packed RGBA of `bits` per channel (8: one byte per
+// channel; 16: native-endian uint16 per channel): width×height pixels, or, when `block` is more
+// than 1×1, (width / block[0])×(height / block[1]) means of block[0]×block[1] pixels each (made
+// while converting from YUV, see StereoFrameSource::reduce_views). width, height and aspect are
+// always those of the full view.
+struct StereoVideoFrame {
+  int width = 0, height = 0, bits = 8;
+  std::vector<std::uint8_t> left, right;
+  double aspect = 0.0;
+  double pts_s = 0.0;  // time from the source's origin: from 0 at the start (or the requested start)
+  std::array<int, 2> block{1, 1};
+};
+
+inline std::size_t bytes_per_pixel(int bits) { return bits > 8 ? 8 : 4; }
+
+// Interleaved stereo float samples (L R L R …), −1..1.
+struct AudioChunk {
+  double pts_s = 0.0;  // time of the first sample
+  std::vector<float> samples;
+  std::int64_t frames() const { return static_cast<std::int64_t>(samples.size() / 2); }
+};
+
+}  // namespace nelf

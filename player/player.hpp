@@ -1,0 +1,62 @@
+#pragma once
+// The player engine behind `nelf play` (DESIGN.md §7): a decode thread fills a bounded queue of
+// stereo frames; the display's thread (the caller's) paces them against the master clock with
+// FrameScheduler, uploads each new frame's two views once, composites both eyes with GlCompositor
+// straight into the display's packed framebuffer (on software GL, 8-bit block means: from composite
+// tables on the CPU, the next frames ahead on a worker thread (CompositeAhead), then one upload of
+// the packed frame) and presents. An audio thread feeds SDL2 audio, whose clock is master; without
+// sound a system clock is. Keys change playback and the optics live.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "compositor/compositor.hpp"
+#include "optics/profile.hpp"
+#include "hmz_output/display.hpp"
+#include "player/frame_scheduler.hpp"
+#include "hmz_output/signal.hpp"
+#include "inputs/stereo_frame_source.hpp"
+
+namespace nelf {
+
+struct PlayerOptions {
+  Profile profile;
+  Signal signal;
+  CompositorOptions compositor;
+  bool audio = true;           // false: --no-audio
+  bool allow_network = false;  // for reopening the input's audio
+  int audio_rate = 48000;
+  std::string log_frames;  // CSV of every refresh (diagnostics); "" = none
+  bool quiet = false;      // no "playing …" / audio status lines on stderr (warnings still are)
+  // Each key's change said on screen for 2 s. Off (tests): while a message shows, frames are
+  // composited with GL (the text is drawn there), so without them the CPU path and its frames
+  // composited ahead are seen right after a key.
+  bool on_screen_messages = true;
+  // Called after each new frame is rendered into the packed framebuffer, before present(); the
+  // display's context is current (tests read the frame back here).
+  std::function<void(const Display&, double pts_s)> after_render;
+};
+
+enum class PlayEnd { end_of_file, quit_key, window_closed, interrupted };
+
+struct PlayResult {
+  PlayEnd end = PlayEnd::end_of_file;
+  FrameCounters counters;
+  std::int64_t video_decode_errors = 0;
+  std::int64_t audio_decode_errors = 0;
+  std::int64_t composited_ahead = 0;  // frames shown as composited ahead on a worker (CPU path)
+  bool had_sound = false;
+  std::string sound;  // "pulseaudio, 48000 Hz …" or why there was none
+};
+
+// Plays `source` on `display` until the end of the file, q/Esc, the window closing or `*stop`
+// becoming true (SIGINT/SIGTERM). Must be called on the display's thread. Throws UserError for
+// unusable input or outputs (the panel does not fit the signal, the display is lost).
+PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions& options,
+                const std::atomic<bool>* stop = nullptr);
+
+// The one line printed at exit: "played 48 frames: 48 shown, 0 repeated, 0 dropped".
+std::string play_summary(const PlayResult& result);
+
+}  // namespace nelf
