@@ -11,11 +11,11 @@
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
 #include "app/live_display.hpp"
-#include "player/calibration_controls.hpp"
 #include "compositor/gl/gl_compositor.hpp"
 #include "compositor/overlays/text_overlay.hpp"
-#include "hmz_output/packing.hpp"
 #include "core/printable.hpp"
+#include "hmz_output/packing.hpp"
+#include "player/calibration_controls.hpp"
 
 namespace nelf::app {
 
@@ -29,7 +29,7 @@ constexpr auto kIdlePresent = std::chrono::milliseconds(100);
 constexpr auto kPoll = std::chrono::milliseconds(10);
 
 std::unique_ptr<Display> open_display(const CalibrateSession& s) {
-  return open_live_display({s.output, s.monitor, s.connector, "nelf calibrate (h: help)"}, s.profile, s.signal);
+  return open_live_display({s.output, s.monitor, s.connector, "nelf calibrate (h: help)", s.gpu}, s.profile, s.signal);
 }
 
 // The pattern's views on the GPU, rebuilt when the pattern or its geometry changes.

@@ -1,25 +1,27 @@
 #pragma once
 // The interactive part of `nelf calibrate`: a live display showing the current test pattern through
 // the compositor, keys handled by CalibrationControls, each change shown briefly on screen.
+#include <optional>
 #include <string>
 
 #include "compositor/compositor.hpp"
-#include "optics/profile.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/signal.hpp"
 #include "inputs/test_patterns.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf::app {
 
 struct CalibrateSession {
-  OutputKind output = OutputKind::window;
+  std::string output = "window";  // a row of hmz_output/display_drivers.cpp
   Profile profile;
   Signal signal;
   TestPattern pattern = TestPattern::stripes;
   CompositorOptions compositor;
-  std::string monitor;    // fullscreen: a name to match ("" = the one containing "HMZ")
-  std::string connector;  // kms: connector name ("" = the first with a 3D frame-packing mode)
-  std::string save;       // .toml path written on w and at the end ("" = nowhere)
+  std::string monitor;     // fullscreen: a name to match ("" = the one containing "HMZ")
+  std::string connector;   // kms: connector name ("" = the first with a 3D frame-packing mode)
+  std::string save;        // .toml path written on w and at the end ("" = nowhere)
+  std::optional<int> gpu;  // offscreen: the EGL device
 };
 
 // Runs until q/Esc, the window is closed or an interrupt (app/interrupt.hpp); saves to session.save (when given) on

@@ -14,11 +14,12 @@
 #include "app/calibrate_session.hpp"
 #include "app/commands.hpp"
 #include "app/input_files.hpp"
-#include "player/calibration_controls.hpp"
-#include "optics/profile.hpp"
 #include "hmz_output/display.hpp"
+#include "hmz_output/display_drivers.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "inputs/test_patterns.hpp"
+#include "optics/profile.hpp"
+#include "player/calibration_controls.hpp"
 
 namespace nelf::app {
 namespace {
@@ -36,14 +37,7 @@ struct CalibrateArgs {
   bool overwrite = false;
 };
 
-bool is_output_kind(const std::string& name) {
-  try {
-    parse_output_kind(name);
-    return true;
-  } catch (const std::invalid_argument&) {
-    return false;
-  }
-}
+bool is_live_output(const std::string& name) { return find_display_driver(name) != nullptr; }
 
 TestPattern parse_pattern_option(const std::string& name) {
   const auto pattern = parse_test_pattern(name);
@@ -80,8 +74,8 @@ void write_pattern_image(const CalibrateArgs& args) {
                     2);
   if (!args.save.empty())
     throw UserError(
-        "--save keeps what the keys adjusted and needs a window (--output window, fullscreen, kms or "
-        "quad-buffer), not an image file",
+        fmt::format("--save keeps what the keys adjusted and needs a window (--output {}), not an image file",
+                    display_driver_names()),
         2);
   InputFiles inputs;
   inputs.add(args.profile, "the --profile");
@@ -114,10 +108,11 @@ void check_save_path(const std::string& path) {
 }
 
 void run_calibrate(const CalibrateArgs& args) {
-  if (!is_output_kind(args.output)) return write_pattern_image(args);
-  refuse_gpu_for_live_output(args.gpu, "a live calibration");
+  if (!is_live_output(args.output)) return write_pattern_image(args);
+  if (args.output != "offscreen") refuse_gpu_for_live_output(args.gpu, "a live calibration");
   CalibrateSession session;
-  session.output = parse_output_kind(args.output);
+  session.output = args.output;
+  session.gpu = args.gpu;
   session.pattern = args.pattern.empty() ? TestPattern::stripes : parse_pattern_option(args.pattern);
   session.compositor = compositor_options(args);
   session.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
@@ -154,7 +149,7 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--profile", args->profile, "Device profile to start from: built-in name or TOML file")
       ->capture_default_str();
   cmd->add_option("--output", args->output,
-                  "window, fullscreen, kms or quad-buffer; or an image file (.png, .tif, .exr, .jpg) for --pattern")
+                  fmt::format("{}; or an image file (.png, .tif, .exr, .jpg) for --pattern", display_driver_help()))
       ->capture_default_str();
   cmd->add_option("--monitor", args->monitor,
                   "fullscreen: the monitor whose name contains this (default: one containing \"HMZ\")");

@@ -9,12 +9,13 @@
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
 #include "app/live_display.hpp"
-#include "hmz_output/display.hpp"
-#include "player/player.hpp"
 #include "core/printable.hpp"
+#include "hmz_output/display.hpp"
+#include "hmz_output/display_drivers.hpp"
 #include "inputs/stereo_frame_source.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/video_source.hpp"
+#include "player/player.hpp"
 
 namespace nelf::app {
 namespace {
@@ -30,17 +31,17 @@ struct PlayArgs : CommonArgs {
 
 void run_play(const PlayArgs& args) {
   quiet_ffmpeg_logs(true);
-  refuse_gpu_for_live_output(args.gpu, "play");
+  // Off screen, play renders headless like convert, on the GPU --gpu picks.
+  if (args.output != "offscreen") refuse_gpu_for_live_output(args.gpu, "play");
   CommonOptions common = parse_common_options(args, false);
-  OutputKind kind;
   try {
-    kind = parse_output_kind(args.output);
+    display_driver(args.output);
   } catch (const std::invalid_argument& e) {
     throw UserError(e.what(), 2);
   }
-  if (!args.monitor.empty() && kind != OutputKind::fullscreen)
+  if (!args.monitor.empty() && args.output != "fullscreen")
     throw UserError("--monitor chooses the monitor for --output fullscreen", 2);
-  if (!args.connector.empty() && kind != OutputKind::kms)
+  if (!args.connector.empty() && args.output != "kms")
     throw UserError("--connector chooses the HDMI connector for --output kms", 2);
 
   StereoSourceRequest request;
@@ -62,8 +63,9 @@ void run_play(const PlayArgs& args) {
   options.log_frames = args.log_frames;
   options.quiet = args.quiet;
 
-  const auto display = open_live_display({kind, args.monitor, args.connector, fmt::format("nelf: {}", args.input)},
-                                         common.profile, common.signal);
+  const auto display =
+      open_live_display({args.output, args.monitor, args.connector, fmt::format("nelf: {}", args.input), args.gpu},
+                        common.profile, common.signal);
   if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", printable(display->description()));
 
   InterruptGuard guard;
@@ -78,7 +80,7 @@ void add_play_command(CLI::App& app) {
   auto args = std::make_shared<PlayArgs>();
   auto* cmd = app.add_subcommand("play", "Watch a stereo video on the display (HMD over HDMI, or a preview window)");
   add_common_options(*cmd, *args);
-  cmd->add_option("--output", args->output, "Where to show it: window, fullscreen, kms or quad-buffer")
+  cmd->add_option("--output", args->output, fmt::format("Where to show it: {}", display_driver_help()))
       ->capture_default_str();
   cmd->add_option("--monitor", args->monitor, "fullscreen: the monitor (default: the one named like HMZ)");
   cmd->add_option("--connector", args->connector, "kms: the connector, e.g. HDMI-A-1 (default: the first with 3D)");

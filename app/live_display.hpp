@@ -3,19 +3,21 @@
 // panel under the signal, on the kind of output the user chose (hmz_output/display.hpp). Failures
 // become UserError (exit 1) with the display's own one-line message.
 #include <memory>
+#include <optional>
 #include <string>
 
-#include "optics/profile.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/signal.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf::app {
 
 struct LiveDisplayRequest {
-  OutputKind kind = OutputKind::window;
-  std::string monitor;    // fullscreen: a name to match ("" = the one containing "HMZ")
-  std::string connector;  // kms: connector name ("" = the first with a 3D frame-packing mode)
+  std::string output = "window";  // a row of hmz_output/display_drivers.cpp
+  std::string monitor;            // fullscreen: a name to match ("" = the one containing "HMZ")
+  std::string connector;          // kms: connector name ("" = the first with a 3D frame-packing mode)
   std::string title = "nelf";
+  std::optional<int> gpu;  // offscreen only
 };
 
 std::unique_ptr<Display> open_live_display(const LiveDisplayRequest& request, const Profile& profile,

@@ -3,13 +3,14 @@
 // KMS scan-out. `nelf play` and `nelf calibrate` render every packed frame with the GL compositor
 // into the display's packed framebuffer (GlCompositor::render_eye at the eye areas of
 // hmz_output/packing), or (`nelf play` on software GL) on the CPU from composite tables into its
-// texture, then call present(). Each kind of display is its own file
-// (window_display.*, kms_display.*) with its own factory; this header is the contract between them
-// and the commands.
+// texture, then call present(). Each kind of display is its own file (window_display.*,
+// kms_display.*, offscreen_display.cpp) and one row of the table in display_drivers.cpp; this
+// header is the contract between them and the player.
 #include <epoxy/gl.h>
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,20 +20,14 @@
 
 namespace nelf {
 
-enum class OutputKind { window, fullscreen, kms, quad_buffer };
-
-// Parses "window", "fullscreen", "kms", "quad-buffer"; throws std::invalid_argument listing them.
-OutputKind parse_output_kind(const std::string& name);
-std::string output_kind_name(OutputKind kind);
-
 struct DisplayOptions {
-  OutputKind kind = OutputKind::window;
   Signal signal;                // packed frame size and (for HDMI signals) timing
   std::array<int, 2> packed{};  // the packed frame in pixels (signal.packed_width/height of the panel)
   std::string monitor;          // fullscreen: monitor name to match ("" = the one containing "HMZ")
   std::string connector;        // kms: connector name, e.g. "HDMI-A-1" ("" = the first connected one
                                 // offering a 3D frame-packing mode)
   std::string title = "nelf";   // window title
+  std::optional<int> gpu;       // offscreen: the EGL device (--gpu; unset: NELF_GPU, else the first hardware one)
 };
 
 class Display {

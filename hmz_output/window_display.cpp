@@ -171,12 +171,12 @@ std::optional<KeyPress::Named> named_key(int key) {
 
 class WindowDisplay final : public Display {
  public:
-  explicit WindowDisplay(const DisplayOptions& options) : options_(options) {
+  WindowDisplay(const DisplayOptions& options, WindowMode mode) : options_(options), mode_(mode) {
     if (options.packed[0] <= 0 || options.packed[1] <= 0)
       throw std::invalid_argument(
           fmt::format("window display: empty packed frame {}x{}", options.packed[0], options.packed[1]));
     shown_size_ = options.packed;
-    if (options.kind == OutputKind::quad_buffer) {
+    if (mode == WindowMode::quad_buffer) {
       // Each back buffer shows one eye: the window is an eye's size.
       const auto eye = eye_size(options);
       const auto left = eye_area(options.signal, Eye::left, eye[0], eye[1]);
@@ -191,7 +191,7 @@ class WindowDisplay final : public Display {
     display_name_ = std::getenv("DISPLAY");
 
     ChosenMonitor fullscreen_monitor;
-    if (options.kind == OutputKind::fullscreen) {
+    if (mode == WindowMode::fullscreen) {
       fullscreen_monitor = choose_glfw_monitor(options);
       if (!fullscreen_monitor.monitor) throw std::runtime_error(fullscreen_monitor.error);
     }
@@ -205,7 +205,7 @@ class WindowDisplay final : public Display {
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
     glfwWindowHint(GLFW_DEPTH_BITS, 0);
     glfwWindowHint(GLFW_STENCIL_BITS, 0);
-    glfwWindowHint(GLFW_STEREO, options.kind == OutputKind::quad_buffer ? GLFW_TRUE : GLFW_FALSE);
+    glfwWindowHint(GLFW_STEREO, mode == WindowMode::quad_buffer ? GLFW_TRUE : GLFW_FALSE);
     // Losing focus must not minimise the HMD's picture (the user types on the other monitor).
     glfwWindowHint(GLFW_AUTO_ICONIFY, GLFW_FALSE);
     glfwWindowHint(GLFW_VISIBLE, GLFW_FALSE);  // sized first, shown after
@@ -237,7 +237,7 @@ class WindowDisplay final : public Display {
     const GLfloat black[4] = {0.f, 0.f, 0.f, 1.f};
     glClearNamedFramebufferfv(packed_fbo_.id(), GL_COLOR, 0, black);
 
-    if (options.kind == OutputKind::quad_buffer) {
+    if (mode == WindowMode::quad_buffer) {
       GLboolean stereo = GL_FALSE;
       glGetBooleanv(GL_STEREO, &stereo);
       if (!stereo) throw std::runtime_error(quad_buffer_advice("the window has no stereo buffers"));
@@ -275,7 +275,7 @@ class WindowDisplay final : public Display {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    if (options_.kind == OutputKind::quad_buffer) {
+    if (mode_ == WindowMode::quad_buffer) {
       present_stereo(fb_width, fb_height);
     } else {
       glDrawBuffer(GL_BACK);
@@ -300,7 +300,7 @@ class WindowDisplay final : public Display {
 
   std::string toggle_fullscreen() override {
     GLFWwindow* window = context_->window();
-    if (options_.kind == OutputKind::quad_buffer) return "fullscreen is not available on a quad-buffer output";
+    if (mode_ == WindowMode::quad_buffer) return "fullscreen is not available on a quad-buffer output";
     if (glfwGetWindowMonitor(window)) {
       const bool opened_fullscreen = windowed_size_[0] == 0;
       glfwSetWindowMonitor(window, nullptr, windowed_position_[0], windowed_position_[1],
@@ -325,9 +325,9 @@ class WindowDisplay final : public Display {
 
   std::string description() const override {
     const bool fullscreen = glfwGetWindowMonitor(context_->window()) != nullptr;
-    std::string kind = options_.kind == OutputKind::quad_buffer ? "quad-buffer window"
-                       : fullscreen                             ? "fullscreen on " + monitor_name_
-                                                                : std::string("window");
+    std::string kind = mode_ == WindowMode::quad_buffer ? "quad-buffer window"
+                       : fullscreen                     ? "fullscreen on " + monitor_name_
+                                                        : std::string("window");
     return fmt::format("{} {}x{} on {} ({}, {}, {:g} Hz)", kind, options_.packed[0], options_.packed[1], display_name_,
                        context_->renderer(), vsync_ ? "vsync" : "no vsync", refresh_hz_);
   }
@@ -356,7 +356,7 @@ class WindowDisplay final : public Display {
 
   [[noreturn]] void throw_creation_error() {
     const std::string why = take_glfw_error();
-    if (options_.kind == OutputKind::quad_buffer && last_glfw_error_code == GLFW_FORMAT_UNAVAILABLE)
+    if (mode_ == WindowMode::quad_buffer && last_glfw_error_code == GLFW_FORMAT_UNAVAILABLE)
       throw std::runtime_error(quad_buffer_advice(why));
     if (last_glfw_error_code == GLFW_VERSION_UNAVAILABLE || last_glfw_error_code == GLFW_API_UNAVAILABLE)
       throw std::runtime_error("OpenGL 4.5 core is not available on this X display (" + why +
@@ -507,6 +507,7 @@ class WindowDisplay final : public Display {
   }
 
   DisplayOptions options_;
+  WindowMode mode_;
   std::string display_name_;
   std::string monitor_name_;
   std::shared_ptr<WindowContext> context_;
@@ -524,16 +525,8 @@ class WindowDisplay final : public Display {
 
 }  // namespace
 
-std::unique_ptr<Display> open_window_display(const DisplayOptions& options) {
-  switch (options.kind) {
-    case OutputKind::window:
-    case OutputKind::fullscreen:
-    case OutputKind::quad_buffer:
-      return std::make_unique<WindowDisplay>(options);
-    case OutputKind::kms:
-      break;
-  }
-  throw std::invalid_argument("open_window_display: " + output_kind_name(options.kind) + " is not a window output");
+std::unique_ptr<Display> open_window_display(const DisplayOptions& options, WindowMode mode) {
+  return std::make_unique<WindowDisplay>(options, mode);
 }
 
 }  // namespace nelf

@@ -8,18 +8,20 @@
 
 namespace nelf {
 
-// Opens a display of kind OutputKind::window, fullscreen or quad_buffer; its context is current on
+// How a GLFW display shows the packed frame (each a row of display_drivers.cpp).
+enum class WindowMode { window, fullscreen, quad_buffer };
+
+// Opens a display in `mode`; its context is current on
 // the calling thread, which must be the main thread (GLFW's rule) and must make every later call.
 // Throws std::runtime_error with one actionable line when there is no X display, GLFW cannot start,
 // OpenGL 4.5 core is unavailable, the monitor is not found or not in the packed mode (fullscreen),
-// or the driver offers no stereo visuals (quad-buffer); std::invalid_argument for another kind, an
-// empty packed size, or quad-buffer with a signal that does not carry both eyes.
-// The window belongs to the context: it closes when both the display and every holder of context()
-// (e.g. a GlCompositor) are gone. Destroy the compositor first to close it with the display.
+// or the driver offers no stereo visuals (quad-buffer); std::invalid_argument for an empty packed size, or quad-buffer
+// with a signal that does not carry both eyes. The window belongs to the context: it closes when both the display and
+// every holder of context() (e.g. a GlCompositor) are gone. Destroy the compositor first to close it with the display.
 // vsync() is false on software renderers and without GLX swap control; otherwise a few swaps with
 // interval 1 are timed at opening (swap_timing.hpp). refresh_hz(): the monitor's mode, else the
 // signal's timing, else 60. Losing the X server makes present()/poll_events() throw and
 // close_requested() true instead of Xlib ending the process.
-std::unique_ptr<Display> open_window_display(const DisplayOptions& options);
+std::unique_ptr<Display> open_window_display(const DisplayOptions& options, WindowMode mode);
 
 }  // namespace nelf

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -257,7 +259,7 @@ TEST(PlayCliErrors, BadInputsAsConvertSaysThem) {
   }
   const auto output = run_command("env -u DISPLAY " + std::string(NELF_BINARY) + " play " + q(clip) + " --output hdmi");
   EXPECT_EQ(output.status, 2);
-  EXPECT_NE(output.err.find("unknown output 'hdmi' (expected window, fullscreen, kms or quad-buffer)"),
+  EXPECT_NE(output.err.find("unknown output 'hdmi' (expected window, fullscreen, kms, quad-buffer or offscreen)"),
             std::string::npos)
       << output.err;
 }
@@ -272,6 +274,46 @@ TEST(PlayCliErrors, GpuIsRefusedAsItCannotApply) {
   EXPECT_EQ(r.err,
             "nelf: --gpu picks the GPU of headless rendering (convert, simulate, calibrate --output FILE); "
             "play renders on its display's GPU (--output kms: NELF_DRM_DEVICE picks the card)\n");
+}
+
+}  // namespace
+}  // namespace nelf::test
+
+namespace nelf::test {
+namespace {
+
+// The offscreen output runs the real player loop with no display server: the clip plays to its end
+// in its own time on the clock, and the summary counts every frame.
+TEST(PlayOffscreen, PlaysWithoutADisplayServerAndPrintsTheSummary) {
+  TempDir dir;
+  const auto log = dir / "frames.csv";
+  const auto started = std::chrono::steady_clock::now();
+  const auto r = run_command("env -u DISPLAY LP_NUM_THREADS=2 " + std::string(NELF_BINARY) +
+                             " play synthetic:duration=2 --output offscreen --no-audio --log-frames " + q(log));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("nelf: playing on offscreen 1280x1470 ("), std::string::npos) << r.err;
+  unsigned shown = 0, repeated = 0, dropped = 0;
+  const auto summary = r.err.find("frames shown");
+  ASSERT_NE(summary, std::string::npos) << r.err;
+  const auto line = r.err.rfind("nelf: ", summary);
+  ASSERT_EQ(
+      std::sscanf(r.err.c_str() + line, "nelf: %u frames shown, %u repeated, %u dropped", &shown, &repeated, &dropped),
+      3)
+      << r.err;
+  EXPECT_EQ(shown + dropped, 48u) << r.err;  // 2 s at 24 fps
+  const auto rows = read_log(log);
+  ASSERT_FALSE(rows.empty());
+  EXPECT_GT(rows.back().clock, 1.9);  // paced by the clock: the clip's time, not as fast as it renders
+  EXPECT_GT(std::chrono::steady_clock::now() - started, std::chrono::seconds(2));
+}
+
+// --gpu applies off screen (headless rendering), and a device EGL does not list is refused.
+TEST(PlayOffscreen, TakesGpuAndRefusesADeviceEglDoesNotList) {
+  const auto r = run_command("env -u DISPLAY " + std::string(NELF_BINARY) +
+                             " play synthetic:duration=1 --output offscreen --no-audio --gpu 99");
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("GPU 99 requested but EGL lists"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
 
 }  // namespace

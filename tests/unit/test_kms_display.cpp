@@ -37,7 +37,6 @@ class ScopedEnv {
 
 DisplayOptions kms_options() {
   DisplayOptions o;
-  o.kind = OutputKind::kms;
   o.signal = *find_signal("hdmi-fp-720p60");
   o.packed = {1280, 1470};
   return o;

@@ -93,7 +93,7 @@ class PlayerWindowTest : public ::testing::Test {
     DisplayOptions display_options;
     display_options.signal = options.signal;
     display_options.packed = {options.signal.packed_width(160), options.signal.packed_height(90)};
-    return open_window_display(display_options);
+    return open_window_display(display_options, WindowMode::window);
   }
 };
 

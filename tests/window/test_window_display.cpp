@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "compositor/gl/gl_compositor.hpp"
-#include "optics/profile.hpp"
 #include "hmz_output/packing.hpp"
 #include "hmz_output/window_display.hpp"
+#include "optics/profile.hpp"
 #include "support/x11_window.hpp"
 #include "support/xvfb.hpp"
 
@@ -26,9 +26,8 @@ namespace {
 
 using Rgb = std::array<int, 3>;
 
-DisplayOptions frame_packed_options(OutputKind kind) {
+DisplayOptions frame_packed_options() {
   DisplayOptions options;
-  options.kind = kind;
   options.signal = *find_signal("hdmi-fp-720p60");
   options.packed = {options.signal.packed_width(1280), options.signal.packed_height(720)};
   return options;
@@ -61,7 +60,7 @@ class WindowDisplayTest : public ::testing::Test {
 };
 
 TEST_F(WindowDisplayTest, ShowsThePackedFrameOneToOneWhenItFitsTopRowAtTheTop) {
-  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  auto display = open_window_display(frame_packed_options(), WindowMode::window);
   ASSERT_NE(display->packed_framebuffer(), 0u);
   EXPECT_EQ(display->packed_size(), (std::array<int, 2>{1280, 1470}));
   draw_quadrants(*display);
@@ -84,7 +83,7 @@ TEST_F(WindowDisplayTest, ShowsThePackedFrameOneToOneWhenItFitsTopRowAtTheTop) {
 // top row) uploaded into packed_texture() as GL_BGRA. Its colours reach the window as they are (on
 // llvmpipe upload and 1:1 blit are then plain copies; a wrong order would swap red and blue).
 TEST_F(WindowDisplayTest, ABgraPackedFrameUploadedIntoThePackedTextureShowsItsColours) {
-  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  auto display = open_window_display(frame_packed_options(), WindowMode::window);
   const auto [w, h] = display->packed_size();
   const std::array<Rgb, 4> colours{{{200, 40, 30}, {20, 160, 90}, {10, 60, 230}, {250, 250, 5}}};
   std::vector<std::uint8_t> bgra(static_cast<std::size_t>(w) * h * 4);
@@ -112,7 +111,7 @@ TEST_F(WindowDisplayTest, ABgraPackedFrameUploadedIntoThePackedTextureShowsItsCo
 }
 
 TEST_F(WindowDisplayTest, ScalesToFitAResizedWindowWithBlackBars) {
-  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  auto display = open_window_display(frame_packed_options(), WindowMode::window);
   GLFWwindow* window = glfwGetCurrentContext();
   glfwSetWindowSize(window, 1000, 500);
   // Xvfb has no window manager: the resize is immediate once the server has seen it.
@@ -146,10 +145,10 @@ TEST_F(WindowDisplayTest, ScalesToFitAResizedWindowWithBlackBars) {
 
 TEST_F(WindowDisplayTest, WindowIsSizedToTheWorkAreaKeepingTheAspect) {
   // A packed frame taller than the 1600-row screen is shrunk to fit, aspect kept.
-  DisplayOptions options = frame_packed_options(OutputKind::window);
+  DisplayOptions options = frame_packed_options();
   options.signal = *find_signal("hdmi-fp-1080p24");
   options.packed = {1920, 2205};
-  auto display = open_window_display(options);
+  auto display = open_window_display(options, WindowMode::window);
   int width = 0, height = 0;
   glfwGetFramebufferSize(glfwGetCurrentContext(), &width, &height);
   EXPECT_EQ(height, 1600);
@@ -157,7 +156,7 @@ TEST_F(WindowDisplayTest, WindowIsSizedToTheWorkAreaKeepingTheAspect) {
 }
 
 TEST_F(WindowDisplayTest, SoftwareSwapsAreNotVsyncAndTheRefreshIsKnown) {
-  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  auto display = open_window_display(frame_packed_options(), WindowMode::window);
   EXPECT_TRUE(display->context()->is_software()) << display->context()->renderer();
   EXPECT_FALSE(display->vsync());
   EXPECT_GT(display->refresh_hz(), 0.0);
@@ -169,14 +168,14 @@ TEST_F(WindowDisplayTest, SoftwareSwapsAreNotVsyncAndTheRefreshIsKnown) {
 }
 
 TEST_F(WindowDisplayTest, ClosingTheWindowIsReported) {
-  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  auto display = open_window_display(frame_packed_options(), WindowMode::window);
   glfwSetWindowShouldClose(glfwGetCurrentContext(), GLFW_TRUE);
   EXPECT_TRUE(display->close_requested());
 }
 
 TEST_F(WindowDisplayTest, TwoDisplaysInTurnEachGetAWorkingContext) {
   for (int i = 0; i < 2; ++i) {
-    auto display = open_window_display(frame_packed_options(OutputKind::window));
+    auto display = open_window_display(frame_packed_options(), WindowMode::window);
     draw_quadrants(*display);
     display->present();
     EXPECT_EQ(read_window().at(0, 0), red);
@@ -185,7 +184,7 @@ TEST_F(WindowDisplayTest, TwoDisplaysInTurnEachGetAWorkingContext) {
 
 TEST_F(WindowDisplayTest, QuadBufferOnMesaSaysThereAreNoStereoVisuals) {
   try {
-    open_window_display(frame_packed_options(OutputKind::quad_buffer));
+    open_window_display(frame_packed_options(), WindowMode::quad_buffer);
     FAIL() << "Mesa offered a stereo visual";
   } catch (const std::runtime_error& e) {
     const std::string message = e.what();
@@ -196,14 +195,14 @@ TEST_F(WindowDisplayTest, QuadBufferOnMesaSaysThereAreNoStereoVisuals) {
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   }
   // A failed open leaves GLFW usable.
-  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  auto display = open_window_display(frame_packed_options(), WindowMode::window);
   EXPECT_NE(display->packed_framebuffer(), 0u);
 }
 
 // Xvfb's one RandR output is called "screen", its mode is the server's screen size, refresh unknown.
 TEST_F(WindowDisplayTest, FullscreenWithoutAnHmzListsTheMonitors) {
   try {
-    open_window_display(frame_packed_options(OutputKind::fullscreen));
+    open_window_display(frame_packed_options(), WindowMode::fullscreen);
     FAIL() << "went fullscreen without an HMZ monitor";
   } catch (const std::runtime_error& e) {
     EXPECT_STREQ(e.what(),
@@ -213,10 +212,10 @@ TEST_F(WindowDisplayTest, FullscreenWithoutAnHmzListsTheMonitors) {
 }
 
 TEST_F(WindowDisplayTest, FullscreenOnAMonitorInAnotherModeGivesTheXrandrCommands) {
-  DisplayOptions options = frame_packed_options(OutputKind::fullscreen);
+  DisplayOptions options = frame_packed_options();
   options.monitor = "screen";
   try {
-    open_window_display(options);
+    open_window_display(options, WindowMode::fullscreen);
     FAIL() << "went fullscreen on a 1920x1600 monitor";
   } catch (const std::runtime_error& e) {
     EXPECT_STREQ(e.what(),
@@ -248,9 +247,9 @@ class PackedSizeScreenTest : public ::testing::Test {
 };
 
 TEST_F(PackedSizeScreenTest, FullscreenShowsThePackedFramePixelForPixel) {
-  DisplayOptions options = frame_packed_options(OutputKind::fullscreen);
+  DisplayOptions options = frame_packed_options();
   options.monitor = "SCREEN";
-  auto display = open_window_display(options);
+  auto display = open_window_display(options, WindowMode::fullscreen);
   EXPECT_NE(display->description().find("fullscreen on screen 1280x1470"), std::string::npos) << display->description();
   EXPECT_DOUBLE_EQ(display->refresh_hz(), 60.0);  // Xvfb reports no refresh: the signal's
   draw_hairlines(*display);
@@ -267,9 +266,9 @@ TEST_F(PackedSizeScreenTest, FullscreenShowsThePackedFramePixelForPixel) {
 }
 
 TEST_F(PackedSizeScreenTest, ToggleFullscreenAndBack) {
-  DisplayOptions options = frame_packed_options(OutputKind::window);
+  DisplayOptions options = frame_packed_options();
   options.monitor = "screen";
-  auto display = open_window_display(options);
+  auto display = open_window_display(options, WindowMode::window);
   EXPECT_EQ(display->toggle_fullscreen(), "fullscreen on screen");
   EXPECT_NE(display->description().find("fullscreen on screen"), std::string::npos) << display->description();
   draw_hairlines(*display);
@@ -281,7 +280,7 @@ TEST_F(PackedSizeScreenTest, ToggleFullscreenAndBack) {
 }
 
 TEST_F(WindowDisplayTest, ToggleFullscreenWithoutAnHmzSaysWhyInOneLine) {
-  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  auto display = open_window_display(frame_packed_options(), WindowMode::window);
   EXPECT_EQ(display->toggle_fullscreen(),
             "fullscreen: no monitor name contains \"HMZ\"; connected monitors: screen 1920x1600; pass --monitor NAME");
   EXPECT_EQ(display->description().rfind("window 1280x1470", 0), 0u) << display->description();
@@ -297,7 +296,7 @@ std::vector<KeyPress> poll_until(Display& display, std::size_t count) {
 }
 
 TEST_F(WindowDisplayTest, KeysArriveAsTypedCharactersOrByName) {
-  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  auto display = open_window_display(frame_packed_options(), WindowMode::window);
   GLFWwindow* window = glfwGetCurrentContext();
   // US layout on Xvfb: '+' is Shift+'=' there, but the key press carries the character typed.
   for (const char* key : {"plus", "minus", "bracketleft", "bracketright", "s", "space", "Left", "Right", "Up", "Down",
@@ -346,8 +345,8 @@ std::array<double, 3> mean(const test::WindowCapture& screen, int x0, int y0, in
 // The path `nelf play` takes: the GL compositor renders both eyes in the window's own (GLX) context
 // straight into the packed framebuffer at the eye areas, then present().
 TEST_F(WindowDisplayTest, TheCompositorRendersIntoThePackedFrameInTheWindowsContext) {
-  const DisplayOptions options = frame_packed_options(OutputKind::window);
-  auto display = open_window_display(options);
+  const DisplayOptions options = frame_packed_options();
+  auto display = open_window_display(options, WindowMode::window);
   GlCompositor compositor(load_profile("hmz-t1"), {1, std::nullopt}, display->context());
   const gl::Texture left = upload_texture(flat(320, 180, {0.f, 1.f, 0.f, 1.f}), GL_RGBA8);
   const gl::Texture right = upload_texture(flat(320, 180, {1.f, 0.f, 0.f, 1.f}), GL_RGBA8);
@@ -373,7 +372,7 @@ TEST_F(WindowDisplayTest, NoOpenGL45IsAClearError) {
   // Mesa's override makes the driver offer OpenGL 3.3 only.
   setenv("MESA_GL_VERSION_OVERRIDE", "3.3", 1);
   try {
-    open_window_display(frame_packed_options(OutputKind::window));
+    open_window_display(frame_packed_options(), WindowMode::window);
     unsetenv("MESA_GL_VERSION_OVERRIDE");
     FAIL() << "opened a 4.5 context on a 3.3 driver";
   } catch (const std::runtime_error& e) {
@@ -382,12 +381,12 @@ TEST_F(WindowDisplayTest, NoOpenGL45IsAClearError) {
     EXPECT_EQ(message.rfind("OpenGL 4.5 core is not available on this X display (", 0), 0u) << message;
     EXPECT_NE(message.find("--output kms"), std::string::npos) << message;
   }
-  auto display = open_window_display(frame_packed_options(OutputKind::window));  // the override is gone
+  auto display = open_window_display(frame_packed_options(), WindowMode::window);  // the override is gone
   EXPECT_NE(display->packed_framebuffer(), 0u);
 }
 
 TEST_F(WindowDisplayTest, LosingTheXServerIsAnExceptionNotAnExit) {
-  auto display = open_window_display(frame_packed_options(OutputKind::window));
+  auto display = open_window_display(frame_packed_options(), WindowMode::window);
   display->present();
   xvfb_.kill_now();
   EXPECT_THROW(
@@ -404,7 +403,7 @@ TEST_F(WindowDisplayTest, LosingTheXServerIsAnExceptionNotAnExit) {
   // And a later display on another server works.
   test::XvfbServer another;
   test::ScopedDisplay use_it(another.display_name());
-  auto next = open_window_display(frame_packed_options(OutputKind::window));
+  auto next = open_window_display(frame_packed_options(), WindowMode::window);
   draw_quadrants(*next);
   next->present();
   EXPECT_EQ(read_window().at(0, 0), red);
@@ -413,7 +412,7 @@ TEST_F(WindowDisplayTest, LosingTheXServerIsAnExceptionNotAnExit) {
 TEST(WindowDisplayErrors, NoDisplayVariable) {
   test::ScopedDisplay no_display("");
   try {
-    open_window_display(frame_packed_options(OutputKind::window));
+    open_window_display(frame_packed_options(), WindowMode::window);
     FAIL() << "opened a window without DISPLAY";
   } catch (const std::runtime_error& e) {
     EXPECT_STREQ(e.what(),
@@ -424,7 +423,7 @@ TEST(WindowDisplayErrors, NoDisplayVariable) {
 TEST(WindowDisplayErrors, NoXServerAtDisplay) {
   test::ScopedDisplay nowhere(":9873");
   try {
-    open_window_display(frame_packed_options(OutputKind::window));
+    open_window_display(frame_packed_options(), WindowMode::window);
     FAIL() << "opened a window on a display without a server";
   } catch (const std::runtime_error& e) {
     const std::string message = e.what();
@@ -434,14 +433,10 @@ TEST(WindowDisplayErrors, NoXServerAtDisplay) {
 }
 
 TEST(WindowDisplayErrors, QuadBufferNeedsBothEyes) {
-  DisplayOptions options = frame_packed_options(OutputKind::quad_buffer);
+  DisplayOptions options = frame_packed_options();
   options.signal = *find_signal("left");
   options.packed = {1280, 720};
-  EXPECT_THROW(open_window_display(options), std::invalid_argument);
-}
-
-TEST(WindowDisplayErrors, KmsIsNotAWindowOutput) {
-  EXPECT_THROW(open_window_display(frame_packed_options(OutputKind::kms)), std::invalid_argument);
+  EXPECT_THROW(open_window_display(options, WindowMode::quad_buffer), std::invalid_argument);
 }
 
 }  // namespace

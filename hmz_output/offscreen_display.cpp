@@ -1,0 +1,86 @@
+// `--output offscreen`: the live player with no display server (DESIGN.md §7). The packed frame is
+// rendered into a framebuffer object on a headless EGL context (the GPU --gpu or NELF_GPU picks,
+// else the first hardware device, else Mesa's llvmpipe) and shown to no one; the player paces it by the
+// clock at the signal's refresh rate, as it paces a window without vsync. It is what the player's
+// tests run on, and a way to time the whole play loop on a machine without a monitor — as mpv's
+// `--vo=null` and Monado's null compositor are.
+#include <fmt/format.h>
+
+#include <memory>
+#include <stdexcept>
+
+#include "core/gl/egl_context.hpp"
+#include "core/gl/objects.hpp"
+#include "hmz_output/display.hpp"
+
+namespace nelf {
+namespace {
+
+class OffscreenDisplay final : public Display {
+ public:
+  explicit OffscreenDisplay(const DisplayOptions& options) : options_(options) {
+    if (options.packed[0] <= 0 || options.packed[1] <= 0)
+      throw std::invalid_argument(
+          fmt::format("offscreen display: empty packed frame {}x{}", options.packed[0], options.packed[1]));
+    try {
+      context_ = std::make_shared<gl::EglContext>(gl::ContextOptions{options.gpu});
+    } catch (const gl::GlError& e) {
+      throw std::runtime_error(fmt::format("offscreen output: {}", e.what()));
+    }
+    // As a window's: BGRA, so that the CPU path's upload is a copy.
+    packed_texture_ = gl::make_bgra8_texture_2d(options.packed[0], options.packed[1]);
+    packed_fbo_ = gl::make_framebuffer(packed_texture_);
+    const GLfloat black[4] = {0.f, 0.f, 0.f, 1.f};
+    glClearNamedFramebufferfv(packed_fbo_.id(), GL_COLOR, 0, black);
+    refresh_hz_ = options.signal.timing ? options.signal.timing->refresh_hz() : 60.0;
+    gl::check_error("opening the offscreen display");
+  }
+
+  ~OffscreenDisplay() override {
+    // The GL objects die while their context is current.
+    try {
+      context_->make_current();
+    } catch (...) {
+    }
+    packed_fbo_.reset();
+    packed_texture_.reset();
+  }
+  OffscreenDisplay(const OffscreenDisplay&) = delete;
+  OffscreenDisplay& operator=(const OffscreenDisplay&) = delete;
+
+  std::shared_ptr<gl::Context> context() const override { return context_; }
+  GLuint packed_framebuffer() const override { return packed_fbo_.id(); }
+  GLuint packed_texture() const override { return packed_texture_.id(); }
+  std::array<int, 2> packed_size() const override { return options_.packed; }
+
+  // A window's present() ends with the frame finished on the GPU: so does this one, so that the
+  // time a frame takes is the same whether anyone looks at it or not.
+  void present() override {
+    glFinish();
+    gl::check_error("presenting the packed frame");
+  }
+  double refresh_hz() const override { return refresh_hz_; }
+  bool vsync() const override { return false; }
+  std::vector<KeyPress> poll_events() override { return {}; }
+  bool close_requested() const override { return false; }
+
+  std::string description() const override {
+    return fmt::format("offscreen {}x{} ({}, paced at {:g} Hz)", options_.packed[0], options_.packed[1],
+                       context_->renderer(), refresh_hz_);
+  }
+
+ private:
+  DisplayOptions options_;
+  std::shared_ptr<gl::EglContext> context_;
+  gl::Texture packed_texture_;
+  gl::Framebuffer packed_fbo_;
+  double refresh_hz_ = 60.0;
+};
+
+}  // namespace
+
+std::unique_ptr<Display> open_offscreen_display(const DisplayOptions& options) {
+  return std::make_unique<OffscreenDisplay>(options);
+}
+
+}  // namespace nelf
