@@ -24,8 +24,10 @@ here=$(cd "$(dirname "$0")" && pwd)
 out=$(mkdir -p "$out" && cd "$out" && pwd)
 
 mkdir -p "$out/bin" "$out/lib/nelf" "$out/seeds"
-# The module is found beside the executable (bin/../lib/nelf), as in an installed nelf.
-cp "$build/lib/nelf/nelf-oiio.so" "$out/lib/nelf/"
+# The module is found beside the executable (bin/../lib/nelf), as in an installed nelf. Copied as a
+# new file, never over the old one: targets of a campaign already running have that one mapped, and
+# rewriting it in place ends them with SIGBUS (it did, once).
+cp --remove-destination "$build/lib/nelf/nelf-oiio.so" "$out/lib/nelf/"
 
 # Runs one target until it has used BUDGET CPU seconds over all its runs (arguments: target,
 # budget, out, libFuzzer options). The CPU time of a running fuzzer is read from /proc (all its
@@ -55,7 +57,7 @@ while [ "$used" -lt "$budget" ]; do
 done'
 
 for t in "${targets[@]}"; do
-  cp "$build/tests/fuzz/fuzz_$t" "$out/bin/"
+  cp --remove-destination "$build/tests/fuzz/fuzz_$t" "$out/bin/"
   rm -rf "$out/seeds/$t" && cp -r "$build/corpus/seeds/$t" "$out/seeds/$t"
   mkdir -p "$out/corpus/$t" "$out/artifacts/$t"
   dict=()
