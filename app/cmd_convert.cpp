@@ -7,21 +7,24 @@
 #include <optional>
 #include <string>
 
+#include <unistd.h>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include "app/commands.hpp"
 #include "app/convert_video.hpp"
 #include "app/input_files.hpp"
 #include "compositor/make_compositor.hpp"
-#include "optics/profile.hpp"
+#include "core/printable.hpp"
+#include "hmz_output/frame_sink.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
 #include "hmz_output/signal.hpp"
-#include "core/printable.hpp"
 #include "inputs/stereo_layout.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf::app {
 namespace {
@@ -31,7 +34,7 @@ struct ConvertArgs : CommonArgs {
   int bits = 8;
   bool overwrite = false;
   // Video only.
-  std::string codec = "h264";
+  std::optional<std::string> codec;  // unset: h264
   std::optional<int> crf;
   std::optional<double> start, duration;
   std::optional<long> frames;
@@ -70,12 +73,43 @@ ConvertPlan plan_convert(const ConvertArgs& args) {
 
   plan.write.overwrite = args.overwrite;
   plan.write.bits = args.bits;
+  if (is_raw_output(args.output)) return plan;  // stdout: nothing to check
   try {
     check_image_writable(args.output, plan.write);
   } catch (const ImageWriteError& e) {
     throw UserError(e.what(), 1);
   }
   return plan;
+}
+
+// `-` (raw RGBA on stdout) has no codec, bit depth, sound or file to replace: options that would do
+// nothing are refused rather than ignored, and a terminal is not fed binary.
+void refuse_options_raw_cannot_apply(const ConvertArgs& args) {
+  const auto refuse = [](const std::string& option) {
+    throw UserError(fmt::format("{} does not apply to - (raw 8-bit RGBA frames on stdout)", option), 2);
+  };
+  if (args.codec) refuse("--codec");
+  if (args.crf) refuse("--crf");
+  if (args.bits != 8) refuse("--bits");
+  if (::isatty(STDOUT_FILENO) == 1)
+    throw UserError(
+        "-: stdout is a terminal; raw video is for a pipe (e.g. nelf convert IN - | ffplay -f rawvideo "
+        "-pixel_format rgba -video_size WxH -)",
+        2);
+}
+
+// A still to `-`: its one packed frame, as the raw sink writes a video's.
+void write_packed_still_raw(const StereoPair& views, const ConvertPlan& plan) {
+  const auto compositor = make_compositor(plan.profile, plan.compositor);
+  const Image packed = pack_eyes(plan.signal, compositor->compose(views));
+  PackedFrame frame{packed.width(), packed.height(), 8, {}, 0.0};
+  frame.rgba.resize(static_cast<std::size_t>(packed.width()) * packed.height() * 4);
+  const float* in = packed.data();
+  for (std::size_t i = 0; i < frame.rgba.size(); ++i)
+    frame.rgba[i] = static_cast<std::uint8_t>(std::lround(std::clamp(in[i], 0.f, 1.f) * 255.f));
+  const auto sink = open_raw_frame_sink(STDOUT_FILENO, frame.width, frame.height, 1.0);
+  sink->write(frame);
+  sink->finish();
 }
 
 void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
@@ -91,7 +125,7 @@ void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
   r.compositor = common.compositor;
   r.profile = std::move(common.profile);
   r.signal = common.signal;
-  r.encoder.codec = args.codec;
+  r.encoder.codec = args.codec.value_or("h264");
   r.encoder.crf = args.crf;
   r.encoder.overwrite = args.overwrite;
   r.encoder.audio = !args.no_audio;
@@ -123,6 +157,11 @@ void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
   r.strict = args.strict;
   r.allow_network = args.allow_network;
   r.max_pixels = args.max_pixels;
+  if (is_raw_output(args.output)) {
+    refuse_options_raw_cannot_apply(args);
+    if (!args.quiet) quiet_ffmpeg_logs(true);
+    return convert_video(r);
+  }
   const std::filesystem::path out(args.output);
   const auto dir = out.parent_path().empty() ? std::filesystem::path(".") : out.parent_path();
   std::error_code ec;
@@ -143,8 +182,9 @@ void run_convert(const ConvertArgs& args) {
   inputs.add(args.input, "the input");
   inputs.add(args.right, "the --right view");
   inputs.add(args.profile, "the --profile");
-  inputs.refuse_as_output(args.output);
+  if (!is_raw_output(args.output)) inputs.refuse_as_output(args.output);
   if (!is_still_image(args.input)) return run_convert_video(args, inputs);
+  if (is_raw_output(args.output)) refuse_options_raw_cannot_apply(args);
   const ConvertPlan plan = plan_convert(args);
   StillStereo still;
   try {
@@ -154,6 +194,7 @@ void run_convert(const ConvertArgs& args) {
   }
   if (!still.decision.warning.empty()) fmt::print(stderr, "nelf: warning: {}\n", printable(still.decision.warning));
 
+  if (is_raw_output(args.output)) return write_packed_still_raw(still.views, plan);
   write_packed_still(still.views, plan.profile, plan.signal, plan.compositor, args.output, plan.write);
 }
 
@@ -265,7 +306,7 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--bits", args->bits, "Bits per channel of the output file: 8, or 16 for .png/.tif")
       ->capture_default_str();
   cmd->add_flag("-y,--overwrite", args->overwrite, "Replace the output file if it exists");
-  cmd->add_option("--codec", args->codec, "Video: h264, hevc, ffv1 or any FFmpeg video encoder")->capture_default_str();
+  cmd->add_option("--codec", args->codec, "Video: h264 (default), hevc, ffv1 or any FFmpeg video encoder");
   cmd->add_option("--crf", args->crf, "Video: quality for h264/hevc (0 best .. 51; default 18)");
   cmd->add_option("--start", args->start, "Video: start at this time (seconds)");
   cmd->add_option("--duration", args->duration, "Video: convert this many seconds");

@@ -17,35 +17,29 @@
 
 extern "C" {
 #include <libavformat/avformat.h>
+#include <unistd.h>
 }
 
 #include "app/commands.hpp"
 #include "app/interrupt.hpp"
 #include "compositor/cpu/composite_table_cache.hpp"
-#include "core/gl/egl_context.hpp"
 #include "compositor/gl/gl_compositor.hpp"
+#include "core/bounded_queue.hpp"
+#include "core/ffmpeg_raii.hpp"
+#include "core/gl/egl_context.hpp"
+#include "hmz_output/frame_sink.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
-#include "player/progress.hpp"
-#include "core/bounded_queue.hpp"
 #include "inputs/ffmpeg_input.hpp"
-#include "core/ffmpeg_raii.hpp"
 #include "inputs/stereo_frame_source.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
+#include "player/progress.hpp"
 
 namespace nelf::app {
 
 namespace {
-
-// Where packed frames go: an encoded file or an image sequence.
-class FrameSink {
- public:
-  virtual ~FrameSink() = default;
-  virtual void write(const PackedFrame& frame) = 0;
-  virtual void finish() = 0;
-};
 
 // Carries the source's audio and subtitles: a second demuxer on the same file, read in step with
 // the video so the muxer's interleaving buffer stays small.
@@ -109,7 +103,7 @@ class EncodedFileSink final : public FrameSink {
  public:
   EncodedFileSink(const VideoConvertRequest& r, StereoFrameSource& source, int width, int height, int bits,
                   double origin_s)
-      : source_(source) {
+      : source_(source), output_(r.output) {
     if (!source.audio_path().empty() && r.encoder.audio)
       carrier_.emplace(source.audio_path(), origin_s, r.allow_network);
     EncoderSettings settings = r.encoder;
@@ -148,9 +142,11 @@ class EncodedFileSink final : public FrameSink {
     if (carrier_) carrier_->carry_until(*encoder_, last_end_s_, last_end_s_);
     encoder_->finish();
   }
+  std::string description() const override { return output_; }
 
  private:
   StereoFrameSource& source_;
+  std::string output_;
   std::optional<SourcePacketCarrier> carrier_;
   std::optional<VideoEncoder> encoder_;
   std::optional<double> end_s_;
@@ -186,6 +182,7 @@ class ImageSequenceSink final : public FrameSink {
     if (single_ && single_frame_) write_frame(*single_frame_, pattern_);
     finished_ = true;
   }
+  std::string description() const override { return pattern_; }
 
  private:
   void write_frame(const PackedFrame& frame, const std::string& name) {
@@ -407,7 +404,45 @@ class FirstError {
   std::atomic<bool> failed_{false};
 };
 
+// What a sink is opened with, once the packed frame's size is known.
+struct FrameSinkContext {
+  const VideoConvertRequest& request;
+  StereoFrameSource& source;
+  int width, height, bits;
+};
+
+// The outputs of `nelf convert` for video, chosen by the output name: the first row whose test
+// accepts it. A new kind of output is its sink plus one row.
+struct FrameSinkDriver {
+  std::string_view name;
+  bool (*accepts)(const std::string& output);
+  std::unique_ptr<FrameSink> (*open)(const FrameSinkContext& context);
+};
+
+constexpr FrameSinkDriver kFrameSinks[] = {
+    {"raw", is_raw_output,
+     [](const FrameSinkContext& c) {
+       return open_raw_frame_sink(STDOUT_FILENO, c.width, c.height, c.source.frame_rate());
+     }},
+    {"image", [](const std::string& o) { return is_image_sequence_pattern(o) || is_image_file_name(o); },
+     [](const FrameSinkContext& c) -> std::unique_ptr<FrameSink> {
+       return std::make_unique<ImageSequenceSink>(c.request);
+     }},
+    {"encoded", [](const std::string&) { return true; },
+     [](const FrameSinkContext& c) -> std::unique_ptr<FrameSink> {
+       return std::make_unique<EncodedFileSink>(c.request, c.source, c.width, c.height, c.bits, c.source.origin_s());
+     }},
+};
+
+std::unique_ptr<FrameSink> open_frame_sink(const FrameSinkContext& context) {
+  for (const FrameSinkDriver& driver : kFrameSinks)
+    if (driver.accepts(context.request.output)) return driver.open(context);
+  throw std::logic_error("no frame sink accepts " + context.request.output);
+}
+
 }  // namespace
+
+bool is_raw_output(const std::string& output) { return output == "-"; }
 
 bool is_image_sequence_pattern(const std::string& output) {
   static const std::regex pattern("%0?[0-9]*d");
@@ -490,10 +525,7 @@ void convert_video(const VideoConvertRequest& r) {
   std::unique_ptr<FrameSink> sink;
   try {
     const auto [width, height] = size_future.get();
-    if (is_image_sequence_pattern(r.output) || is_image_file_name(r.output))
-      sink = std::make_unique<ImageSequenceSink>(r);
-    else
-      sink = std::make_unique<EncodedFileSink>(r, *source, width, height, bits, source->origin_s());
+    sink = open_frame_sink({r, *source, width, height, bits});
     ProgressReporter progress(total, ProgressReporter::style_for(r.quiet));
     std::jthread watchdog([&](std::stop_token stop) {
       while (!stop.stop_requested()) {
@@ -523,7 +555,7 @@ void convert_video(const VideoConvertRequest& r) {
       fmt::print(stderr, "nelf: warning: {}; converted what decodes\n", printable(what));
     }
     sink->finish();
-    progress.finish(fmt::format("wrote {}", r.output));
+    progress.finish(fmt::format("wrote {}", sink->description()));
   } catch (...) {
     decoded.abort();
     packed.abort();

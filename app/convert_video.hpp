@@ -5,11 +5,11 @@
 
 #include "app/input_files.hpp"
 #include "compositor/compositor.hpp"
-#include "optics/profile.hpp"
+#include "core/pixel_limit.hpp"
 #include "hmz_output/signal.hpp"
 #include "hmz_output/video_encoder.hpp"
-#include "core/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf::app {
 
@@ -33,6 +33,9 @@ struct VideoConvertRequest {
   bool allow_network = false;
   std::int64_t max_pixels = kDefaultMaxPixels;
 };
+
+// True for `-`: raw packed frames on stdout (hmz_output/frame_sink.hpp).
+bool is_raw_output(const std::string& output);
 
 // True when `output` names an image sequence (a printf pattern like %05d).
 bool is_image_sequence_pattern(const std::string& output);

@@ -24,6 +24,16 @@ struct StereoVideoFrame {
 
 inline std::size_t bytes_per_pixel(int bits) { return bits > 8 ? 8 : 4; }
 
+// A packed output frame (both eyes' elemental images in the signal's layout) as bytes: RGBA, row 0
+// the top row, `bits` per channel (16: native-endian uint16).
+struct PackedFrame {
+  int width = 0;
+  int height = 0;
+  int bits = 8;
+  std::vector<std::uint8_t> rgba;  // width × height × 4 × (bits / 8) bytes
+  double pts_seconds = 0.0;
+};
+
 // Interleaved stereo float samples (L R L R …), −1..1.
 struct AudioChunk {
   double pts_s = 0.0;  // time of the first sample

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "core/frames.hpp"
+
 struct AVFormatContext;
 struct AVPacket;
 
@@ -22,15 +24,6 @@ struct EncoderSettings {
   bool overwrite = false;  // -y
   bool audio = true;       // carry the source's audio streams
   int bits = 8;            // bit depth to keep: 10-bit sources keep 10 bits where the codec allows
-};
-
-// One frame of the packed signal: 8-bit (bits = 8) or 16-bit (bits = 16) RGBA, rows top to bottom.
-struct PackedFrame {
-  int width = 0;
-  int height = 0;
-  int bits = 8;
-  std::vector<std::uint8_t> rgba;  // width × height × 4 × (bits / 8) bytes
-  double pts_seconds = 0.0;
 };
 
 class VideoEncoder {
