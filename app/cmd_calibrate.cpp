@@ -11,15 +11,15 @@
 #include <optional>
 #include <string>
 
-#include "app/calibrate_session.hpp"
 #include "app/commands.hpp"
-#include "app/input_files.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/display_drivers.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "inputs/test_patterns.hpp"
 #include "optics/profile.hpp"
+#include "player/calibrate_session.hpp"
 #include "player/calibration_controls.hpp"
+#include "player/input_files.hpp"
 
 namespace nelf::app {
 namespace {
@@ -125,22 +125,6 @@ void run_calibrate(const CalibrateArgs& args) {
 }
 
 }  // namespace
-
-void save_calibrated_profile(const Profile& profile, const std::string& path) {
-  // The saved file is a profile of its own, not the one it started from.
-  Profile saved = profile;
-  saved.name = calibrated_profile_name(path);
-  try {
-    write_file_atomically(path, true, [&](const std::filesystem::path& temporary) {
-      std::ofstream out(temporary, std::ios::binary);
-      out << profile_to_toml(saved);
-      out.close();
-      if (!out) throw ImageWriteError(fmt::format("{}: cannot write the profile (disk full?)", path));
-    });
-  } catch (const ImageWriteError& e) {
-    throw UserError(e.what(), 1);
-  }
-}
 
 void add_calibrate_command(CLI::App& app) {
   auto args = std::make_shared<CalibrateArgs>();

@@ -12,8 +12,6 @@
 #include <cmath>
 #include <filesystem>
 #include "app/commands.hpp"
-#include "app/convert_video.hpp"
-#include "app/input_files.hpp"
 #include "compositor/make_compositor.hpp"
 #include "core/printable.hpp"
 #include "hmz_output/frame_sink.hpp"
@@ -25,6 +23,8 @@
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "optics/profile.hpp"
+#include "player/convert_video.hpp"
+#include "player/input_files.hpp"
 
 namespace nelf::app {
 namespace {

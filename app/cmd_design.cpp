@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.hpp"
-#include "app/input_files.hpp"
+#include "player/input_files.hpp"
 #include "optics/design.hpp"
 #include "analysis/design_plot.hpp"
 #include "optics/profile.hpp"

@@ -7,14 +7,14 @@
 #include <string>
 
 #include "app/commands.hpp"
-#include "app/interrupt.hpp"
-#include "app/live_display.hpp"
 #include "core/printable.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/display_drivers.hpp"
 #include "inputs/stereo_frame_source.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/video_source.hpp"
+#include "player/interrupt.hpp"
+#include "player/live_display.hpp"
 #include "player/player.hpp"
 
 namespace nelf::app {
@@ -69,7 +69,7 @@ void run_play(const PlayArgs& args) {
   if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", printable(display->description()));
 
   InterruptGuard guard;
-  const PlayResult result = play(*display, *source, options, &interrupted);
+  const PlayResult result = play(*display, *source, options, &interrupt_requested);
   fmt::print(stderr, "nelf: {}\n", play_summary(result));
   if (result.end == PlayEnd::interrupted) throw UserError("interrupted", 130);
 }

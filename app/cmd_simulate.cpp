@@ -15,7 +15,7 @@
 #include <fmt/ranges.h>
 #include "app/commands.hpp"
 #include "app/heatmap.hpp"
-#include "app/input_files.hpp"
+#include "player/input_files.hpp"
 #include "analysis/eye_simulator.hpp"
 #include "compositor/make_compositor.hpp"
 #include "optics/mapping.hpp"

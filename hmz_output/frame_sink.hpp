@@ -1,7 +1,7 @@
 #pragma once
 // Where `nelf convert` sends its packed frames, one after the other: an encoded video file, an image
 // sequence, one image, or raw RGBA on stdout. Chosen by the output name, one row each in the
-// table of app/convert_video.cpp. A sink destroyed before finish() leaves nothing behind.
+// table of player/convert_video.cpp. A sink destroyed before finish() leaves nothing behind.
 #include <memory>
 #include <string>
 

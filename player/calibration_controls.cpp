@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "optics/mapping.hpp"
+#include "player/key_bindings.hpp"
 
 namespace nelf {
 
@@ -61,15 +62,7 @@ CalibrationControls::CalibrationControls(Profile profile, TestPattern pattern, d
       lit_fraction_(least_lit_fraction(profile_, content_aspect_)) {}
 
 const std::vector<std::string>& CalibrationControls::help_lines() {
-  static const std::vector<std::string> lines = {
-      "Tab: adjust both eyes / left / right",
-      "arrows: shift 1 px (Shift+arrow 0.1 px)",
-      "r R: rotation -/+0.05 deg   p P: pitch scale -/+0.0005",
-      "g G: lens gap -/+0.005 mm   [ ]: IPD -/+0.5 mm",
-      "d D: prescription -/+0.25 D",
-      "1 stripes  2 grid  3 Snellen  4 white",
-      "w: save   h: this help   q Esc: quit (saves to --save)",
-  };
+  static const std::vector<std::string> lines = key_help(KeyScope::calibrate);
   return lines;
 }
 
@@ -186,58 +179,65 @@ CalibrationStep CalibrationControls::change_prescription(double delta) {
 }
 
 CalibrationStep CalibrationControls::apply(const KeyPress& key) {
-  using Named = KeyPress::Named;
   CalibrationStep step;
-  if (key.is(Named::tab)) {
-    eye_ = eye_ == CalibrationEye::both   ? CalibrationEye::left
-           : eye_ == CalibrationEye::left ? CalibrationEye::right
-                                          : CalibrationEye::both;
-    step.message = fmt::format("adjusting {}", calibration_eye_name(eye_));
-    return step;
-  }
-  const double px = key.shift ? fine_shift_step_px : shift_step_px;
-  if (key.is(Named::left)) return shift(-px, 0.0);
-  if (key.is(Named::right)) return shift(px, 0.0);
-  if (key.is(Named::up)) return shift(0.0, -px);  // shift_px moves the image down for +y
-  if (key.is(Named::down)) return shift(0.0, px);
-  if (key.is(Named::escape) || key.is(U'q')) {
-    step.quit = true;
-    return step;
-  }
-  if (key.named != Named::none) return step;
-  if (key.ctrl || key.alt) {
+  if (key.named == KeyPress::Named::none && (key.ctrl || key.alt)) {
     // Ctrl+C in the window quits as it would in the terminal; other combinations are not ours.
     step.quit = key.ctrl && (key.character == U'c' || key.character == U'q');
     return step;
   }
-  switch (key.character) {
-    case U'r':
+  const std::optional<Command> command = command_for(KeyScope::calibrate, key);
+  if (!command) {
+    if (key.named == KeyPress::Named::none && key.character >= 0x20 && key.character < 0x7f)
+      step.message = fmt::format("key '{}' does nothing (h: help)", static_cast<char>(key.character));
+    return step;
+  }
+  const double px = key.shift ? fine_shift_step_px : shift_step_px;
+  switch (*command) {
+    case Command::next_eye:
+      eye_ = eye_ == CalibrationEye::both   ? CalibrationEye::left
+             : eye_ == CalibrationEye::left ? CalibrationEye::right
+                                            : CalibrationEye::both;
+      step.message = fmt::format("adjusting {}", calibration_eye_name(eye_));
+      return step;
+    case Command::shift_left:
+      return shift(-px, 0.0);
+    case Command::shift_right:
+      return shift(px, 0.0);
+    case Command::shift_up:
+      return shift(0.0, -px);  // shift_px moves the image down for +y
+    case Command::shift_down:
+      return shift(0.0, px);
+    case Command::quit:
+      step.quit = true;
+      return step;
+    case Command::rotate_less:
       return rotate(-rotation_step_deg);
-    case U'R':
+    case Command::rotate_more:
       return rotate(rotation_step_deg);
-    case U'p':
+    case Command::pitch_less:
       return scale_pitch(-pitch_scale_step);
-    case U'P':
+    case Command::pitch_more:
       return scale_pitch(pitch_scale_step);
-    case U'g':
+    case Command::gap_less:
       return change_gap(-gap_step_mm);
-    case U'G':
+    case Command::gap_more:
       return change_gap(gap_step_mm);
-    case U'[':
+    case Command::ipd_narrower:
       return change_ipd(-ipd_step_mm);
-    case U']':
+    case Command::ipd_wider:
       return change_ipd(ipd_step_mm);
-    case U'd':
+    case Command::prescription_less:
       return change_prescription(-prescription_step_diopters);
-    case U'D':
+    case Command::prescription_more:
       return change_prescription(prescription_step_diopters);
-    case U'1':
-    case U'2':
-    case U'3':
-    case U'4': {
-      static constexpr TestPattern patterns[] = {TestPattern::stripes, TestPattern::grid, TestPattern::snellen,
-                                                 TestPattern::white};
-      const TestPattern next = patterns[key.character - U'1'];
+    case Command::pattern_stripes:
+    case Command::pattern_grid:
+    case Command::pattern_snellen:
+    case Command::pattern_white: {
+      const TestPattern next = *command == Command::pattern_stripes   ? TestPattern::stripes
+                               : *command == Command::pattern_grid    ? TestPattern::grid
+                               : *command == Command::pattern_snellen ? TestPattern::snellen
+                                                                      : TestPattern::white;
       if (next == TestPattern::snellen) {
         try {
           snellen_letter_height_px(pattern_geometry(profile_), 20);
@@ -251,19 +251,15 @@ CalibrationStep CalibrationControls::apply(const KeyPress& key) {
       step.message = fmt::format("pattern {}", test_pattern_name(pattern_));
       return step;
     }
-    case U'w':
+    case Command::save:
       step.save = true;
       return step;
-    case U'h':
-    case U'?':
+    case Command::help:
       step.help = true;
       return step;
     default:
-      break;
+      return step;  // a play command: not bound in calibrate
   }
-  if (key.character >= 0x20 && key.character < 0x7f)
-    step.message = fmt::format("key '{}' does nothing (h: help)", static_cast<char>(key.character));
-  return step;
 }
 
 }  // namespace nelf

@@ -5,22 +5,15 @@
 // must still work (the screen fits the field of view, and at least min_lit_fraction of each eye's
 // panel still shows it), so a saved profile always loads and shows a picture.
 //
-//   Tab          adjust both eyes / the left eye / the right eye
-//   arrows       shift the image 1 px (Shift: 0.1 px)         calibration.<eye>.shift_px
-//   r / R        rotation -/+ 0.05 deg                         calibration.<eye>.rotation_deg
-//   p / P        pitch scale -/+ 0.0005                        calibration.<eye>.pitch_scale
-//   g / G        lens gap -/+ 0.005 mm (both eyes)             lens_array.gap_mm
-//   [ / ]        IPD -/+ 0.5 mm                                viewing.ipd_mm
-//   d / D        prescription -/+ 0.25 D                       correction.prescription_diopters
-//   1 2 3 4      stripes, grid, Snellen chart, white
-//   w            save now;  h  help (each press the next line);  q / Esc / Ctrl+C  quit
+// Which key does what is the calibrate rows of player/key_bindings.cpp; the README's table and the
+// help lines are made from them.
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include "optics/profile.hpp"
 #include "core/keys.hpp"
 #include "inputs/test_patterns.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf {
 

@@ -16,18 +16,19 @@
 #include <thread>
 #include <vector>
 
-#include "compositor/cpu/composite_table_cache.hpp"
-#include "core/gl/objects.hpp"
-#include "compositor/gl/gl_compositor.hpp"
-#include "core/image_library.hpp"
-#include "compositor/overlays/text_overlay.hpp"
-#include "hmz_output/audio_output.hpp"
-#include "compositor/overlays/calibration_overlay.hpp"
 #include "compositor/cpu/composite_ahead.hpp"
+#include "compositor/cpu/composite_table_cache.hpp"
+#include "compositor/gl/gl_compositor.hpp"
+#include "compositor/overlays/calibration_overlay.hpp"
+#include "compositor/overlays/text_overlay.hpp"
+#include "core/gl/objects.hpp"
+#include "core/image_library.hpp"
+#include "core/user_error.hpp"
+#include "hmz_output/audio_output.hpp"
 #include "hmz_output/packing.hpp"
 #include "inputs/audio_source.hpp"
 #include "inputs/test_patterns.hpp"
-#include "core/user_error.hpp"
+#include "player/key_bindings.hpp"
 
 namespace nelf {
 
@@ -690,6 +691,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   const auto duration = source.duration_s();
 
   bool paused = false, started = false, calibration = false, swap_eyes = false, dirty = false;
+  std::size_t help_line = 0;  // the next line of the key help that h shows
   bool awaiting_seek = false;
   bool show_while_paused = false;  // a seek while paused shows the first frame at the new place
   std::shared_ptr<const StereoVideoFrame> current;
@@ -754,48 +756,77 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
 
   for (;;) {
     for (const KeyPress& key : display.poll_events()) {
-      if (key.is(KeyPress::Named::escape) || key.is(U'q') || key.is(U'Q')) {
-        result.end = PlayEnd::quit_key;
-      } else if (key.is(KeyPress::Named::space)) {
-        paused = !paused;
-        if (!awaiting_seek && started) clock->set_paused(paused);
-        say(paused ? "paused" : "playing");
-      } else if (key.is(KeyPress::Named::left)) {
-        seek_by(-10);
-      } else if (key.is(KeyPress::Named::right)) {
-        seek_by(10);
-      } else if (key.is(KeyPress::Named::up)) {
-        seek_by(60);
-      } else if (key.is(KeyPress::Named::down)) {
-        seek_by(-60);
-      } else if (key.is(U'+') || key.is(U'=') || key.is(U'-') || key.is(U'_')) {
-        Profile p = renderer.profile();
-        const double now_mm = p.screen.distance_mm > 0 ? p.screen.distance_mm : p.viewing.virtual_image_mm;
-        p.screen.distance_mm = (key.is(U'-') || key.is(U'_')) ? now_mm / 1.25 : now_mm * 1.25;
-        change_profile(p, fmt::format("screen distance {:.0f} mm", p.screen.distance_mm));
-      } else if (key.is(U'[') || key.is(U']')) {
-        Profile p = renderer.profile();
-        p.viewing.ipd_mm += key.is(U'[') ? -0.5 : 0.5;
-        change_profile(p, fmt::format("IPD {:.1f} mm", p.viewing.ipd_mm));
-      } else if (key.is(U's') || key.is(U'S')) {
-        swap_eyes = !swap_eyes;
-        dirty = true;
-        say(swap_eyes ? "eyes swapped" : "eyes as the source says");
-      } else if (key.is(U'c') || key.is(U'C')) {
-        calibration = !calibration;
-        try {
-          if (current) renderer.upload(current, calibration);
-        } catch (const TestPatternError& e) {
-          calibration = false;
-          if (current) renderer.upload(current, calibration);
-          say(fmt::format("no calibration grid: {}", e.what()));
-          continue;
+      const std::optional<Command> command = command_for(KeyScope::play, key);
+      if (!command) continue;
+      switch (*command) {
+        case Command::quit:
+          result.end = PlayEnd::quit_key;
+          break;
+        case Command::pause:
+          paused = !paused;
+          if (!awaiting_seek && started) clock->set_paused(paused);
+          say(paused ? "paused" : "playing");
+          break;
+        case Command::seek_back_10s:
+          seek_by(-10);
+          break;
+        case Command::seek_forward_10s:
+          seek_by(10);
+          break;
+        case Command::seek_forward_60s:
+          seek_by(60);
+          break;
+        case Command::seek_back_60s:
+          seek_by(-60);
+          break;
+        case Command::screen_farther:
+        case Command::screen_nearer: {
+          Profile p = renderer.profile();
+          const double now_mm = p.screen.distance_mm > 0 ? p.screen.distance_mm : p.viewing.virtual_image_mm;
+          p.screen.distance_mm = *command == Command::screen_nearer ? now_mm / 1.25 : now_mm * 1.25;
+          change_profile(p, fmt::format("screen distance {:.0f} mm", p.screen.distance_mm));
+          break;
         }
-        dirty = true;
-        say(calibration ? "calibration grid on" : "calibration grid off");
-      } else if (key.is(U'f') || key.is(U'F')) {
-        say(display.toggle_fullscreen());
-        dirty = true;
+        case Command::ipd_narrower:
+        case Command::ipd_wider: {
+          Profile p = renderer.profile();
+          p.viewing.ipd_mm += *command == Command::ipd_narrower ? -0.5 : 0.5;
+          change_profile(p, fmt::format("IPD {:.1f} mm", p.viewing.ipd_mm));
+          break;
+        }
+        case Command::swap_eyes:
+          swap_eyes = !swap_eyes;
+          dirty = true;
+          say(swap_eyes ? "eyes swapped" : "eyes as the source says");
+          break;
+        case Command::calibration_grid:
+          calibration = !calibration;
+          try {
+            if (current) renderer.upload(current, calibration);
+          } catch (const TestPatternError& e) {
+            calibration = false;
+            if (current) renderer.upload(current, calibration);
+            say(fmt::format("no calibration grid: {}", e.what()));
+            break;
+          }
+          dirty = true;
+          say(calibration ? "calibration grid on" : "calibration grid off");
+          break;
+        case Command::fullscreen:
+          say(display.toggle_fullscreen());
+          dirty = true;
+          break;
+        case Command::help: {
+          // Each press shows the next line on screen; the first also prints them all.
+          const std::vector<std::string> lines = key_help(KeyScope::play);
+          if (help_line == 0 && !options.quiet)
+            for (const std::string& line : lines) fmt::print(stderr, "nelf: key {}\n", line);
+          say(lines[help_line++ % lines.size()]);
+          dirty = true;
+          break;
+        }
+        default:
+          break;  // a calibrate command: not bound in play
       }
     }
     if (result.end == PlayEnd::quit_key) break;

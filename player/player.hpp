@@ -12,11 +12,11 @@
 #include <string>
 
 #include "compositor/compositor.hpp"
-#include "optics/profile.hpp"
 #include "hmz_output/display.hpp"
-#include "player/frame_scheduler.hpp"
 #include "hmz_output/signal.hpp"
 #include "inputs/stereo_frame_source.hpp"
+#include "optics/profile.hpp"
+#include "player/frame_scheduler.hpp"
 
 namespace nelf {
 

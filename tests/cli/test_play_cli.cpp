@@ -202,6 +202,20 @@ TEST_F(PlayCli, ArrowKeySeeksForwardAndQQuits) {
   EXPECT_LT(last, 20.0) << "q did not stop it";
 }
 
+// h shows the key help: every line of the play rows of the key table in the terminal (first press).
+TEST_F(PlayCli, HPrintsTheKeyHelpFromTheTable) {
+  const auto clip = make_clip(dir_, "long.mp4", 30, 24, false);
+  const auto r = run_command(
+      env() + std::string(NELF_BINARY) + " play " + q(clip) + " --profile " + q(small_profile(dir_)) +
+      " & pid=$!; (sleep 60; kill -KILL $pid) 2>/dev/null & guard=$!; export DISPLAY=" + xvfb_.display_name() +
+      "; w=$(timeout 20 xdotool search --sync --name '^nelf: ' | head -1); sleep 1.5; xdotool key --window $w h; "
+      "sleep 1; xdotool key --window $w q; wait $pid; status=$?; kill $guard; echo status $status");
+  EXPECT_NE(r.out.find("status 0\n"), std::string::npos) << r.out << r.err;
+  for (const std::string line :
+       {"space: pause / play", "left right: seek 10 s back / forward", "h: this help", "q Esc: quit"})
+    EXPECT_NE(r.err.find("nelf: key " + line + "\n"), std::string::npos) << line << "\n" << r.err;
+}
+
 // A file cut in the middle (the file ending early): what decodes plays, the loss is counted in the
 // summary line, and the end is a clean exit.
 TEST_F(PlayCli, ATruncatedFilePlaysWhatDecodesAndCountsTheLoss) {

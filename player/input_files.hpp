@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-namespace nelf::app {
+namespace nelf {
 
 class InputFiles {
  public:
@@ -35,4 +35,4 @@ class InputFiles {
   std::vector<Input> inputs_;
 };
 
-}  // namespace nelf::app
+}  // namespace nelf

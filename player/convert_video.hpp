@@ -3,15 +3,15 @@
 #include <optional>
 #include <string>
 
-#include "app/input_files.hpp"
 #include "compositor/compositor.hpp"
 #include "core/pixel_limit.hpp"
 #include "hmz_output/signal.hpp"
 #include "hmz_output/video_encoder.hpp"
 #include "inputs/stereo_layout.hpp"
 #include "optics/profile.hpp"
+#include "player/input_files.hpp"
 
-namespace nelf::app {
+namespace nelf {
 
 struct VideoConvertRequest {
   std::string input;  // a media file or `synthetic:[options]`
@@ -44,4 +44,4 @@ bool is_image_sequence_pattern(const std::string& output);
 // output behind on any failure.
 void convert_video(const VideoConvertRequest& request);
 
-}  // namespace nelf::app
+}  // namespace nelf

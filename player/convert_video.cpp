@@ -1,4 +1,4 @@
-#include "app/convert_video.hpp"
+#include "player/convert_video.hpp"
 #include "core/printable.hpp"
 
 #include <fmt/format.h>
@@ -20,13 +20,12 @@ extern "C" {
 #include <unistd.h>
 }
 
-#include "app/commands.hpp"
-#include "app/interrupt.hpp"
 #include "compositor/cpu/composite_table_cache.hpp"
 #include "compositor/gl/gl_compositor.hpp"
 #include "core/bounded_queue.hpp"
 #include "core/ffmpeg_raii.hpp"
 #include "core/gl/egl_context.hpp"
+#include "core/user_error.hpp"
 #include "hmz_output/frame_sink.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
@@ -35,9 +34,10 @@ extern "C" {
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
+#include "player/interrupt.hpp"
 #include "player/progress.hpp"
 
-namespace nelf::app {
+namespace nelf {
 
 namespace {
 
@@ -484,7 +484,7 @@ void convert_video(const VideoConvertRequest& r) {
     try {
       long count = 0;
       std::optional<StereoVideoFrame> frame = std::move(first);
-      while (frame && !interrupted && !error.failed()) {
+      while (frame && !interrupt_requested && !error.failed()) {
         if (r.max_frames && count >= *r.max_frames) break;
         if (r.duration_s && frame->pts_s >= *r.duration_s - 1e-9) break;
         if (frame->width != view_w || frame->height != view_h || frame->bits != bits || frame->block != block)
@@ -506,7 +506,7 @@ void convert_video(const VideoConvertRequest& r) {
       PackedFrameRenderer renderer(r, view_w, view_h, bits, aspect, block);
       size_promise.set_value({renderer.width(), renderer.height()});
       while (auto frame = decoded.pop()) {
-        if (interrupted || error.failed()) break;
+        if (interrupt_requested || error.failed()) break;
         if (!packed.push(renderer.render(*frame, buffers))) return;
       }
       packed.close();
@@ -529,7 +529,7 @@ void convert_video(const VideoConvertRequest& r) {
     ProgressReporter progress(total, ProgressReporter::style_for(r.quiet));
     std::jthread watchdog([&](std::stop_token stop) {
       while (!stop.stop_requested()) {
-        if (interrupted) {
+        if (interrupt_requested) {
           decoded.abort();
           packed.abort();
           return;
@@ -547,7 +547,7 @@ void convert_video(const VideoConvertRequest& r) {
     watchdog.join();
     decode.join();
     composite.join();
-    if (interrupted) throw UserError("interrupted: no output written", 130);
+    if (interrupt_requested) throw UserError("interrupted: no output written", 130);
     error.rethrow();
     if (const std::int64_t lost = source->lost_frames(); lost > 0) {
       const std::string what = fmt::format("{}: damaged or truncated: {} frame(s) lost or damaged", r.input, lost);
@@ -562,10 +562,10 @@ void convert_video(const VideoConvertRequest& r) {
     if (decode.joinable()) decode.join();
     if (composite.joinable()) composite.join();
     sink.reset();  // removes what it had written
-    if (interrupted) throw UserError("interrupted: no output written", 130);
+    if (interrupt_requested) throw UserError("interrupted: no output written", 130);
     if (error.failed()) error.rethrow();
     throw;
   }
 }
 
-}  // namespace nelf::app
+}  // namespace nelf

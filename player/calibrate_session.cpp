@@ -1,23 +1,26 @@
-#include "app/calibrate_session.hpp"
+#include "player/calibrate_session.hpp"
 
 #include <fmt/format.h>
 
 #include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <thread>
 #include <utility>
 
-#include "app/commands.hpp"
-#include "app/interrupt.hpp"
-#include "app/live_display.hpp"
 #include "compositor/gl/gl_compositor.hpp"
 #include "compositor/overlays/text_overlay.hpp"
 #include "core/printable.hpp"
+#include "core/user_error.hpp"
+#include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
 #include "player/calibration_controls.hpp"
+#include "player/interrupt.hpp"
+#include "player/live_display.hpp"
 
-namespace nelf::app {
+namespace nelf {
 
 namespace {
 
@@ -95,7 +98,7 @@ class Session {
   void loop() {
     auto last_present = std::chrono::steady_clock::now();
     bool dirty = true;
-    while (!interrupted.load() && !display_->close_requested()) {
+    while (!interrupt_requested.load() && !display_->close_requested()) {
       bool quit = false;
       // Keys arrive in batches (key repeat, fast typing): the compositor and the pattern are
       // rebuilt once per batch, for the last state.
@@ -213,4 +216,20 @@ void run_calibrate_session(const CalibrateSession& session) {
   Session(session).run();
 }
 
-}  // namespace nelf::app
+void save_calibrated_profile(const Profile& profile, const std::string& path) {
+  // The saved file is a profile of its own, not the one it started from.
+  Profile saved = profile;
+  saved.name = calibrated_profile_name(path);
+  try {
+    write_file_atomically(path, true, [&](const std::filesystem::path& temporary) {
+      std::ofstream out(temporary, std::ios::binary);
+      out << profile_to_toml(saved);
+      out.close();
+      if (!out) throw ImageWriteError(fmt::format("{}: cannot write the profile (disk full?)", path));
+    });
+  } catch (const ImageWriteError& e) {
+    throw UserError(e.what(), 1);
+  }
+}
+
+}  // namespace nelf

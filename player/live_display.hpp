@@ -10,7 +10,7 @@
 #include "hmz_output/signal.hpp"
 #include "optics/profile.hpp"
 
-namespace nelf::app {
+namespace nelf {
 
 struct LiveDisplayRequest {
   std::string output = "window";  // a row of hmz_output/display_drivers.cpp
@@ -23,4 +23,4 @@ struct LiveDisplayRequest {
 std::unique_ptr<Display> open_live_display(const LiveDisplayRequest& request, const Profile& profile,
                                            const Signal& signal);
 
-}  // namespace nelf::app
+}  // namespace nelf

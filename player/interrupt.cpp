@@ -1,17 +1,17 @@
-#include "app/interrupt.hpp"
+#include "player/interrupt.hpp"
 
 #include <iterator>
 
-namespace nelf::app {
+namespace nelf {
 
-std::atomic<bool> interrupted{false};
+std::atomic<bool> interrupt_requested{false};
 
 namespace {
-extern "C" void on_interrupt(int) { interrupted.store(true); }
+extern "C" void on_interrupt(int) { interrupt_requested.store(true); }
 }  // namespace
 
 InterruptGuard::InterruptGuard() {
-  interrupted.store(false);
+  interrupt_requested.store(false);
   struct sigaction action {};
   action.sa_handler = on_interrupt;
   sigemptyset(&action.sa_mask);
@@ -31,4 +31,4 @@ InterruptGuard::~InterruptGuard() {
     sigaction(interrupt_signals[i], &previous_[i], nullptr);
 }
 
-}  // namespace nelf::app
+}  // namespace nelf

@@ -10,7 +10,7 @@
 #include "inputs/test_patterns.hpp"
 #include "optics/profile.hpp"
 
-namespace nelf::app {
+namespace nelf {
 
 struct CalibrateSession {
   std::string output = "window";  // a row of hmz_output/display_drivers.cpp
@@ -24,11 +24,11 @@ struct CalibrateSession {
   std::optional<int> gpu;  // offscreen: the EGL device
 };
 
-// Runs until q/Esc, the window is closed or an interrupt (app/interrupt.hpp); saves to session.save (when given) on
+// Runs until q/Esc, the window is closed or an interrupt (player/interrupt.hpp); saves to session.save (when given) on
 // w and at the end, saying where on stdout. Throws UserError for a display that cannot open.
 void run_calibrate_session(const CalibrateSession& session);
 
 // Writes `profile` as TOML to `path` (replacing it, never half-written); UserError when it cannot.
 void save_calibrated_profile(const Profile& profile, const std::string& path);
 
-}  // namespace nelf::app
+}  // namespace nelf

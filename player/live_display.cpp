@@ -1,13 +1,13 @@
-#include "app/live_display.hpp"
+#include "player/live_display.hpp"
 
 #include <fmt/format.h>
 
 #include <stdexcept>
 
-#include "app/commands.hpp"
+#include "core/user_error.hpp"
 #include "hmz_output/display_drivers.hpp"
 
-namespace nelf::app {
+namespace nelf {
 
 std::unique_ptr<Display> open_live_display(const LiveDisplayRequest& request, const Profile& profile,
                                            const Signal& signal) {
@@ -29,4 +29,4 @@ std::unique_ptr<Display> open_live_display(const LiveDisplayRequest& request, co
   }
 }
 
-}  // namespace nelf::app
+}  // namespace nelf

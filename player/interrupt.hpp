@@ -7,12 +7,12 @@
 #include <atomic>
 #include <csignal>
 
-namespace nelf::app {
+namespace nelf {
 
 // Set by SIGINT/SIGTERM/SIGHUP/SIGQUIT while an InterruptGuard is alive.
-extern std::atomic<bool> interrupted;
+extern std::atomic<bool> interrupt_requested;
 
-// The signals an InterruptGuard turns into `interrupted`.
+// The signals an InterruptGuard turns into `interrupt_requested`.
 inline constexpr int interrupt_signals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
 
 // Installs the handlers for its lifetime (clearing the flag) and restores the previous ones.
@@ -27,4 +27,4 @@ class InterruptGuard {
   struct sigaction previous_[std::size(interrupt_signals)]{};
 };
 
-}  // namespace nelf::app
+}  // namespace nelf

@@ -1,14 +1,14 @@
-#include "app/input_files.hpp"
+#include "player/input_files.hpp"
 
 #include <fmt/format.h>
 #include <sys/stat.h>
 
 #include <system_error>
 
-#include "inputs/synthetic_source.hpp"
 #include "core/user_error.hpp"
+#include "inputs/synthetic_source.hpp"
 
-namespace nelf::app {
+namespace nelf {
 namespace {
 
 namespace fs = std::filesystem;
@@ -54,4 +54,4 @@ void InputFiles::refuse_as_output(const std::string& output) const {
   }
 }
 
-}  // namespace nelf::app
+}  // namespace nelf

@@ -1,0 +1,77 @@
+#pragma once
+// Keys → commands for `nelf play` and `nelf calibrate`: one table (key_bindings.cpp), from which
+// the loops take what a key press means, and the on-screen and terminal help (h) and the README's
+// key tables are made, so that none of them can drift from what the keys do.
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "core/keys.hpp"
+
+namespace nelf {
+
+enum class KeyScope { play, calibrate };
+
+enum class Command {
+  quit,
+  help,
+  // play
+  pause,
+  seek_back_10s,
+  seek_forward_10s,
+  seek_back_60s,
+  seek_forward_60s,
+  screen_farther,
+  screen_nearer,
+  ipd_narrower,
+  ipd_wider,
+  swap_eyes,
+  calibration_grid,
+  fullscreen,
+  // calibrate
+  next_eye,
+  shift_left,
+  shift_right,
+  shift_up,
+  shift_down,
+  rotate_less,
+  rotate_more,
+  pitch_less,
+  pitch_more,
+  gap_less,
+  gap_more,
+  prescription_less,
+  prescription_more,
+  pattern_stripes,
+  pattern_grid,
+  pattern_snellen,
+  pattern_white,
+  save,
+};
+
+// One line of help: the keys it names and what each does.
+struct KeyBinding {
+  KeyScope scope;
+  std::vector<std::pair<KeyPress, Command>> keys;
+  std::string_view label;           // the keys as the help says them, e.g. "r R", "arrows"
+  std::string_view markdown_label;  // the same for the README, e.g. "`r` / `R`"
+  std::string_view help;            // what they do, short: on screen and in the terminal
+  std::string_view detail;          // more for the README ("" for none)
+  std::string_view profile_key;     // calibrate: the profile key it changes ("" for none)
+};
+
+const std::vector<KeyBinding>& key_bindings();
+
+// What `key` means in `scope`. A printable key matches with Shift (it is the character typed) but
+// not with Ctrl or Alt; a named key (arrows, Tab, …) matches with any modifier.
+std::optional<Command> command_for(KeyScope scope, const KeyPress& key);
+
+// "label: help", one line per row of `scope`.
+std::vector<std::string> key_help(KeyScope scope);
+
+// The README's table of `scope`'s keys (play: key | does; calibrate: key | changes | profile key).
+std::string key_table_markdown(KeyScope scope);
+
+}  // namespace nelf
