@@ -317,5 +317,23 @@ TEST(ConvertStills, BadArgumentsExitTwoBeforeAnyWork) {
                        "unknown signal");
 }
 
+// Found by fuzzing (docs/fuzzing.md, finding 6): 22 bytes of a raw WebP lossless (VP8L) stream whose
+// header claims 16384 x 8192 pixels, under the default --max-pixels. The whole float image was
+// allocated (2 GB) before the decoder failed; now the rows are read in bands, so the memory is the
+// decoder's own. Under a 1.6 GB address-space limit it used to end in bad_alloc; now it fails with
+// the decoder's one line.
+TEST(ConvertStills, ATinyFileClaimingThePixelLimitFailsWithoutThatMemory) {
+  TempDir dir;
+  const unsigned char vp8l[] = {0x2f, 0xff, 0xff, 0xff, 0x17, 0x00, 0x40, 0xec, 0x00, 0xff, 0xda,
+                                0xff, 0xd9, 0x2e, 0x3a, 0xd9, 0xb9, 0x10, 0x4e, 0x2e, 0x47, 0xe2};
+  test::write_file(dir / "claims.png", std::string(reinterpret_cast<const char*>(vp8l), sizeof vp8l));
+  const auto r = test::run_command("ulimit -v 1600000; " + std::string(NELF_BINARY) + " convert " +
+                                   q(dir / "claims.png") + " " + q(dir / "out.png"));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(r.err.find("bad_alloc"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("claims.png: cannot read the image"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.png"));
+}
+
 }  // namespace
 }  // namespace nelf
