@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <string_view>
 
-#include "inputs/ffmpeg_input.hpp"
 #include "core/ffmpeg_raii.hpp"
+#include "inputs/ffmpeg_input.hpp"
 #include "inputs/yuv_block_means.hpp"
 
 extern "C" {
@@ -85,7 +85,19 @@ int rotation_from_display_matrix(const AVStream& stream) {
   return static_cast<int>(((quarter_turns % 4) + 4) % 4) * 90;
 }
 
-ColorMatrix matrix_from_av(AVColorSpace space, bool& tagged) {
+// The value of an FFmpeg enum field as the integer it holds. Decoders and demuxers copy colour
+// tags from the bitstream unchecked (an H.264 VUI may say matrix 84): loading such a field as its
+// enum type is undefined behaviour in C++ (found by fuzzing, docs/fuzzing.md finding 8), reading
+// its bytes is not.
+template <typename Enum>
+int raw_value(const Enum& field) {
+  static_assert(sizeof(Enum) == sizeof(int));
+  int value = 0;
+  std::memcpy(&value, &field, sizeof value);
+  return value;
+}
+
+ColorMatrix matrix_from_av(int space, bool& tagged) {
   tagged = true;
   switch (space) {
     case AVCOL_SPC_BT709:
@@ -159,7 +171,7 @@ bool is_yuv_or_gray(AVPixelFormat format) {
 
 // Whether samples in `format` tagged `range` use the full code range. Untagged YUV is limited
 // (video); untagged grey is full (stills, as swscale assumes); RGB and palettes are always full.
-bool is_full_range(AVPixelFormat format, AVColorRange range) {
+bool is_full_range(AVPixelFormat format, int range) {
   bool jpeg = false;
   without_jpeg_range(format, jpeg);
   if (jpeg || !is_yuv_or_gray(format)) return true;
@@ -370,13 +382,13 @@ struct VideoSource::Impl {
     const auto pixel_format = static_cast<AVPixelFormat>(par.format);
     if (const char* name = av_get_pix_fmt_name(pixel_format)) info.pixel_format = name;
     info.bits_per_component = bits_of(pixel_format);
-    info.matrix = matrix_from_av(par.color_space, info.matrix_tagged);
+    info.matrix = matrix_from_av(raw_value(par.color_space), info.matrix_tagged);
     if (!info.matrix_tagged) info.matrix = default_matrix_for_height(par.height);
     if (!is_yuv_or_gray(pixel_format) && pixel_format != AV_PIX_FMT_NONE) {
       info.matrix = ColorMatrix::rgb;
       info.matrix_tagged = true;
     }
-    info.range = is_full_range(pixel_format, par.color_range) ? ColorRange::full : ColorRange::limited;
+    info.range = is_full_range(pixel_format, raw_value(par.color_range)) ? ColorRange::full : ColorRange::limited;
     info.stream_stereo = stereo_metadata_from_stream(*stream);
 
     codec.reset(avcodec_alloc_context3(decoder));
@@ -425,13 +437,13 @@ struct VideoSource::Impl {
   void colour_of(const AVFrame& decoded, AVPixelFormat& source_format, int& colorspace, bool& full_range) const {
     const auto decoded_format = static_cast<AVPixelFormat>(decoded.format);
     // The frame's own tag (H.264 VUI) wins; an untagged frame inherits the container's.
-    const AVColorRange range =
-        decoded.color_range != AVCOL_RANGE_UNSPECIFIED ? decoded.color_range : stream->codecpar->color_range;
+    const int frame_range = raw_value(decoded.color_range);
+    const int range = frame_range != AVCOL_RANGE_UNSPECIFIED ? frame_range : raw_value(stream->codecpar->color_range);
     full_range = is_full_range(decoded_format, range);
     bool jpeg = false;
     source_format = without_jpeg_range(decoded_format, jpeg);
     bool tagged = false;
-    ColorMatrix matrix = matrix_from_av(decoded.colorspace, tagged);
+    ColorMatrix matrix = matrix_from_av(raw_value(decoded.colorspace), tagged);
     if (!tagged) matrix = info.matrix_tagged ? info.matrix : default_matrix_for_height(decoded.height);
     colorspace = sws_colorspace_for(matrix);
   }

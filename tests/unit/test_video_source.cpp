@@ -166,6 +166,19 @@ TEST_F(VideoSourceTest, UntaggedMatrixDefaultsByHeight) {
   EXPECT_LT(max_error(*hd.next_frame(), kBt709), kColourTolerance);
 }
 
+// A stream may tag a colour matrix FFmpeg's enum does not list (an MPEG-2 sequence display
+// extension holds 0..255, which FFmpeg's decoder copies unchecked): it is untagged, and reading the tag is no undefined
+// behaviour (docs/fuzzing.md finding 8; under the ASan+UBSan unit tests this aborted before the fix).
+TEST_F(VideoSourceTest, AColourMatrixOutsideFfmpegsListIsUntagged) {
+  const auto clip = test::make_media(dir / "odd-matrix.mkv",
+                                     "-f lavfi -i color=c=0x808080:s=64x36:r=10:d=0.3 -c:v mpeg2video -pix_fmt yuv420p "
+                                     "-bsf:v mpeg2_metadata=matrix_coefficients=84");
+  VideoSource source(clip.string());
+  EXPECT_FALSE(source.info().matrix_tagged);
+  EXPECT_EQ(source.info().matrix, ColorMatrix::bt601);  // the default for 36 rows
+  EXPECT_TRUE(source.next_frame());
+}
+
 TEST_F(VideoSourceTest, HonoursLimitedAndFullRange) {
   ASSERT_GT(max_difference(kBt709, kBt709Full), 6.0 / 255.0);
   VideoSource full(flat_yuv(dir, "full.mkv", "64x36", "bt709", "pc").string());
