@@ -1,7 +1,5 @@
 #include "player/live_display.hpp"
 
-#include <fmt/format.h>
-
 #include <stdexcept>
 
 #include "core/user_error.hpp"
@@ -19,9 +17,12 @@ std::unique_ptr<Display> open_live_display(const LiveDisplayRequest& request, co
   options.connector = request.connector;
   options.title = request.title;
   options.gpu = request.gpu;
-  const DisplayDriver* driver = find_display_driver(request.output);
-  if (driver == nullptr)
-    throw UserError(fmt::format("unknown output '{}' (expected {})", request.output, display_driver_names()), 2);
+  const DisplayDriver* driver = nullptr;
+  try {
+    driver = &display_driver(request.output);
+  } catch (const std::invalid_argument& e) {
+    throw UserError(e.what(), 2);
+  }
   try {
     return driver->open(options);
   } catch (const std::exception& e) {
