@@ -5,28 +5,12 @@
 // q = k + ½ of the lens lattice projected onto the display; quad i < u_lenses.x + 1 is the vertical
 // border k = u_first_lens.x - ½ + i, the others are horizontal. Six vertices per quad.
 
-uniform vec2 u_panel;
-uniform vec2 u_pixel_pitch;
-uniform vec2 u_shift;
-uniform vec2 u_rotation;
-uniform float u_to_lens_plane;
-uniform vec2 u_lattice_offset;
-uniform float u_lens_pitch;
-uniform ivec2 u_first_lens;
-uniform ivec2 u_lenses;
+#include "mapping.glsl"
 
 // A (sub-)aperture straddles a border when its centre is within half a pixel of it, measured across
 // the border (area_sample takes apertures square in the lattice's frame). A little more than that
 // covers every such pixel centre and almost nothing else: the area split is the costly shader.
 const float half_width_px = 0.55;
-
-vec2 rotate(vec2 v) { return vec2(u_rotation.x * v.x - u_rotation.y * v.y, u_rotation.y * v.x + u_rotation.x * v.y); }
-
-// Lattice coordinates (units of the lens pitch) to pixel coordinates (x right, y down from the top).
-vec2 lattice_to_pixel(vec2 q) {
-  const vec2 s = (u_lattice_offset + rotate(q * u_lens_pitch)) / u_to_lens_plane;
-  return vec2(s.x / u_pixel_pitch.x + 0.5 * u_panel.x + u_shift.x, 0.5 * u_panel.y + u_shift.y - s.y / u_pixel_pitch.y);
-}
 
 void main() {
   const int quad = gl_VertexID / 6, corner = gl_VertexID % 6;

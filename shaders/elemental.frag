@@ -3,32 +3,18 @@
 // optics/mapping.cpp (view_coordinate) in float. Pixel positions are taken relative to the
 // panel's pixel grid, so float keeps sub-micrometre precision.
 //
-// Compiled twice: as is for pass 1 (point samples over the whole region), and with
-// NELF_AREA_SAMPLE defined for the border strips (a compile-time switch: llvmpipe would otherwise
-// evaluate both sides of a run-time choice for every pixel).
+// Compiled in four variants (compositor/gl/shader_programs.cpp lists them, and the build validates
+// each): as is for pass 1 (point samples over the whole region), with NELF_AREA_SAMPLE for the
+// border strips, NELF_COORDINATE_MAP for pass 1's coordinate map, and NELF_AREA_SAMPLE +
+// NELF_RECORD_TAPS for the CPU composite table. Compile-time switches: llvmpipe would otherwise
+// evaluate both sides of a run-time choice for every pixel.
 //
 // Memory layout: row 0 of the target region is the top row of the eye image (as in nelf::Image);
 // the view textures likewise hold the image's top row first, so t (down) is the texture's y.
 
-uniform sampler2D u_view;      // the view, or its footprint-prefiltered version
-uniform vec2 u_texture_scale;  // u_view coordinate = uv * scale + offset: the prefiltered
-uniform vec2 u_texture_offset; // texture extends beyond the screen (black margin)
-uniform bool u_cut_outside;    // sampling the view itself: black outside the screen
-uniform vec2 u_region_origin;  // lower-left corner of the eye's region in the target (pixels)
-uniform vec2 u_panel;          // panel resolution
-uniform vec2 u_pixel_pitch;    // mm
-uniform vec2 u_shift;          // calibration shift (pixels, right/down)
-uniform vec2 u_rotation;       // cos, sin of the lattice (or, stock, image) rotation
-uniform bool u_has_lens_array;
-uniform float u_to_lens_plane;  // d_e / (d_e + d_l)
-uniform vec2 u_lattice_offset;  // mm
-uniform float u_lens_pitch;     // mm, calibrated
-uniform ivec2 u_first_lens;
-uniform ivec2 u_lenses;
-uniform float u_chief_ray_scale;  // (d_r - d_e) / d_l
-uniform vec2 u_screen_centre;     // mm
-uniform vec2 u_screen_size;       // mm
-uniform vec2 u_view_size;         // mm, stock devices
+layout(binding = 0) uniform sampler2D u_view;  // the view, or its footprint-prefiltered version
+#include "mapping.glsl"
+
 // Sub-samples per axis (1, 2 or 4): a compile-time constant, so the loops below unroll (llvmpipe
 // runs a loop bounded by a uniform with per-lane masks, which cost ~as much as the taps).
 #ifndef NELF_SUBSAMPLES
@@ -38,22 +24,12 @@ const int u_subsamples = NELF_SUBSAMPLES;
 
 out vec4 colour;
 
-vec2 rotate(vec2 v, float sign_) {
-  const float c = u_rotation.x, s = sign_ * u_rotation.y;
-  return vec2(c * v.x - s * v.y, s * v.x + c * v.y);
-}
-
-vec2 display_position(vec2 pixel) {
-  return vec2((pixel.x - 0.5 * u_panel.x - u_shift.x) * u_pixel_pitch.x,
-              (0.5 * u_panel.y - pixel.y + u_shift.y) * u_pixel_pitch.y);
-}
-
 bool inside(vec2 uv) { return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))); }
 
 // The view at screen coordinate uv. The prefiltered texture already fades to black across the
 // screen's edge over the footprint; the raw view is cut there.
 vec3 tap(vec2 uv) {
-  if (u_cut_outside && !inside(uv)) return vec3(0.0);
+  if (u_cut_outside != 0 && !inside(uv)) return vec3(0.0);
   return textureLod(u_view, uv * u_texture_scale + u_texture_offset, 0.0).rgb;
 }
 
@@ -74,13 +50,10 @@ vec3 through_lens(vec2 s, ivec2 lens) {
   return lens_coordinate(s, lens, uv) ? tap(uv) : vec3(0.0);
 }
 
-// Position in the lens lattice (units of the lens pitch, rotated frame) of display position s.
-vec2 lattice_position(vec2 s) { return rotate(s * u_to_lens_plane - u_lattice_offset, -1.0) / u_lens_pitch; }
-
 // view_coordinate(display_position_mm(x, y)) followed by a tap; black where the display is black.
 vec3 point_sample(vec2 pixel) {
   const vec2 s = display_position(pixel);
-  if (!u_has_lens_array) {
+  if (u_has_lens_array == 0) {
     const vec2 r = rotate(s, -1.0);
     const vec2 uv = vec2(r.x / u_view_size.x + 0.5, 0.5 - r.y / u_view_size.y);
     return tap(uv);
@@ -108,7 +81,7 @@ void add_part(inout vec3 sum, int part, float weight, vec2 s, ivec2 lens) { sum 
 // sub-samples do; each part is tapped at its centroid. Interior ones (almost all) take one tap. Exact for an unrotated lattice;
 // for a rotated one the aperture is approximated by an axis-aligned square in lattice coordinates.
 vec3 area_sample(vec2 pixel, float aperture) {
-  if (!u_has_lens_array) return point_sample(pixel);
+  if (u_has_lens_array == 0) return point_sample(pixel);
   const vec2 s = display_position(pixel);
   const vec2 q = lattice_position(s);
   const vec2 half_pixel = 0.5 * aperture * u_pixel_pitch * u_to_lens_plane / u_lens_pitch;
@@ -146,7 +119,7 @@ vec3 area_sample(vec2 pixel, float aperture) {
 // The border strips' part u_part for the CPU composite table (one sub-sample per pixel); alpha 1
 // marks the pixels the strips cover (the target is cleared to 0). One part per pass keeps the
 // target a single panel-sized texture.
-uniform int u_part;
+layout(location = 0) uniform int u_part;
 void main() {
   area_sample(floor(gl_FragCoord.xy - u_region_origin) + 0.5, 1.0);
   colour = recorded[u_part];
@@ -160,7 +133,7 @@ void main() {
   const vec2 s = display_position(floor(gl_FragCoord.xy - u_region_origin) + 0.5);
   vec2 uv;
   bool lit = true;
-  if (!u_has_lens_array) {
+  if (u_has_lens_array == 0) {
     const vec2 r = rotate(s, -1.0);
     uv = vec2(r.x / u_view_size.x + 0.5, 0.5 - r.y / u_view_size.y);
   } else {

@@ -3,9 +3,9 @@
 // NELF_COORDINATE_MAP, rendered once per eye and view geometry): one fetch of the pixel's u_view
 // coordinate, one bilinear tap. Black where the map says -1: the prefiltered view's clamped edge.
 
-uniform sampler2D u_view;      // the footprint-prefiltered view (black margin)
-uniform sampler2D u_map;       // RG32F, panel-sized: u_view coordinate per pixel
-uniform vec2 u_region_origin;  // lower-left corner of the eye's region in the target (pixels)
+layout(binding = 0) uniform sampler2D u_view;  // the footprint-prefiltered view (black margin)
+layout(binding = 1) uniform sampler2D u_map;   // RG32F, panel-sized: u_view coordinate per pixel
+layout(location = 0) uniform vec2 u_region_origin;  // lower-left corner of the eye's region in the target (pixels)
 
 out vec4 colour;
 

@@ -7,13 +7,13 @@
 // is black outside [0, u_view_extent], as on the reference's screen, so a pixel whose footprint
 // straddles the screen's edge gets the right mix of picture and black.
 
-uniform sampler2D u_input;
-uniform int u_axis;           // 0: filter along x, 1: along y
-uniform float u_cell_size;    // view texels per input texel along the axis
-uniform float u_out_spacing;  // view texels per output texel along the axis
-uniform float u_box_width;    // view texels
-uniform float u_out_origin;   // view-texel position of the output grid's first edge (<= 0)
-uniform float u_view_extent;  // the view's size along the axis, in view texels
+layout(binding = 0) uniform sampler2D u_input;
+layout(location = 0) uniform int u_axis;           // 0: filter along x, 1: along y
+layout(location = 1) uniform float u_cell_size;    // view texels per input texel along the axis
+layout(location = 2) uniform float u_out_spacing;  // view texels per output texel along the axis
+layout(location = 3) uniform float u_box_width;    // view texels
+layout(location = 4) uniform float u_out_origin;   // view-texel position of the output grid's first edge (<= 0)
+layout(location = 5) uniform float u_view_extent;  // the view's size along the axis, in view texels
 
 out vec4 colour;
 

@@ -3,8 +3,8 @@
 // (R ∈ {1, 2, 4}), using bilinear taps placed on texel corners so one tap averages up to 2 × 2
 // texels. Reads every view texel once; the result is a small texture the box pass works on.
 
-uniform sampler2D u_view;
-uniform ivec2 u_block;  // R per axis
+layout(binding = 0) uniform sampler2D u_view;
+layout(location = 0) uniform ivec2 u_block;  // R per axis
 
 out vec4 colour;
 

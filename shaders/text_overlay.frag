@@ -5,8 +5,8 @@
 
 layout(binding = 0) uniform sampler2D u_view;
 layout(binding = 1) uniform sampler2D u_label;
-uniform ivec2 u_box_origin;  // the label's top-left corner in output texels
-uniform ivec2 u_box_size;    // the label's size in output texels (its texture may be narrower when
+layout(location = 0) uniform ivec2 u_box_origin;  // the label's top-left corner in output texels
+layout(location = 1) uniform ivec2 u_box_size;    // the label's size in output texels (its texture may be narrower when
                              // the view's pixels are not square)
 
 out vec4 colour;

@@ -1,5 +1,7 @@
 #include "compositor/gl/gl_compositor.hpp"
 
+#include "compositor/gl/shader_interface.hpp"
+
 #include <cstdlib>
 #include <cstring>
 #include <string_view>
@@ -20,19 +22,6 @@ namespace {
 constexpr double samples_per_footprint = 3.0;
 
 int subsamples_per_axis(int fsaa) { return fsaa == 16 ? 4 : fsaa == 4 ? 2 : 1; }
-
-void set_uniform(GLuint program, const char* name, float x) {
-  glProgramUniform1f(program, glGetUniformLocation(program, name), x);
-}
-void set_uniform(GLuint program, const char* name, float x, float y) {
-  glProgramUniform2f(program, glGetUniformLocation(program, name), x, y);
-}
-void set_uniform_int(GLuint program, const char* name, int x) {
-  glProgramUniform1i(program, glGetUniformLocation(program, name), x);
-}
-void set_uniform_int(GLuint program, const char* name, int x, int y) {
-  glProgramUniform2i(program, glGetUniformLocation(program, name), x, y);
-}
 
 float f(double x) { return static_cast<float>(x); }
 
@@ -98,45 +87,17 @@ GlCompositor::GlCompositor(Profile profile, CompositorOptions options, std::shar
   context_->make_current();
   empty_vertex_array_ = gl::make_vertex_array();
   sampler_ = gl::make_linear_clamp_sampler();
+  mapping_block_ = gl::make_uniform_buffer(sizeof(shaders::MappingBlock));
   gl::check_error("creating the compositor");
 }
 
 // Programs are compiled on first use: llvmpipe takes tens of milliseconds a program, and a run
 // needs only some (the CPU composite table two of the seven).
-GLuint GlCompositor::program(ProgramKind kind) {
+GLuint GlCompositor::program(shaders::ProgramKind kind) {
   gl::Program& p = programs_[static_cast<std::size_t>(kind)];
   if (p) return p.id();
-  const std::string subsamples = fmt::format("#define NELF_SUBSAMPLES {}\n", subsamples_per_axis(options_.fsaa));
-  const char* sampler = "u_view";
-  switch (kind) {
-    case ProgramKind::elemental:
-      p = gl::make_program("fullscreen.vert", "elemental.frag", subsamples);
-      break;
-    case ProgramKind::border:
-      p = gl::make_program("border_strips.vert", "elemental.frag", subsamples + "#define NELF_AREA_SAMPLE 1\n");
-      break;
-    case ProgramKind::map:
-      p = gl::make_program("fullscreen.vert", "elemental.frag", subsamples + "#define NELF_COORDINATE_MAP 1\n");
-      sampler = nullptr;
-      break;
-    case ProgramKind::record:
-      p = gl::make_program("border_strips.vert", "elemental.frag",
-                           subsamples + "#define NELF_AREA_SAMPLE 1\n#define NELF_RECORD_TAPS 1\n");
-      sampler = nullptr;
-      break;
-    case ProgramKind::lookup:
-      p = gl::make_program("fullscreen.vert", "elemental_lookup.frag");
-      set_uniform_int(p.id(), "u_map", 1);
-      break;
-    case ProgramKind::reduce:
-      p = gl::make_program("fullscreen.vert", "prefilter_reduce.frag");
-      break;
-    case ProgramKind::box:
-      p = gl::make_program("fullscreen.vert", "prefilter_box.frag");
-      sampler = "u_input";
-      break;
-  }
-  if (sampler) set_uniform_int(p.id(), sampler, 0);
+  const shaders::ProgramSource source = shaders::program_source(kind, subsamples_per_axis(options_.fsaa));
+  p = gl::make_program(source.vertex, source.fragment, source.defines);
   gl::check_error("creating the compositor's programs");
   return p.id();
 }
@@ -170,29 +131,32 @@ GLuint GlCompositor::prefilter(const PrefilterPlan& plan, GLuint view_texture, i
   ensure(t.output, plan.output, t.output_texture, t.output_fbo);
 
   glBindVertexArray(empty_vertex_array_.id());
-  glBindSampler(0, sampler_.id());
+  glBindSampler(shaders::view_unit, sampler_.id());
   GLuint input = view_texture;
   if (reduce) {
     glBindFramebuffer(GL_FRAMEBUFFER, t.reduced_fbo.id());
     glViewport(0, 0, plan.reduced[0], plan.reduced[1]);
-    glUseProgram(program(ProgramKind::reduce));
-    set_uniform_int(program(ProgramKind::reduce), "u_block", plan.block[0], plan.block[1]);
-    glBindTextureUnit(0, input);
+    glUseProgram(program(shaders::ProgramKind::reduce));
+    glProgramUniform2i(program(shaders::ProgramKind::reduce), shaders::location::reduce_block, plan.block[0],
+                       plan.block[1]);
+    glBindTextureUnit(shaders::view_unit, input);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     input = t.reduced_texture.id();
   }
-  glUseProgram(program(ProgramKind::box));
+  const GLuint box = program(shaders::ProgramKind::box);
+  glUseProgram(box);
   const int view_size[2] = {view_width, view_height};
   const auto box_pass = [&](int axis, GLuint fbo, std::array<int, 2> size, double cell) {
-    set_uniform(program(ProgramKind::box), "u_out_origin", f(-plan.margin[axis] * plan.spacing[axis]));
-    set_uniform(program(ProgramKind::box), "u_view_extent", f(view_size[axis]));
+    namespace at = shaders::location::box;
+    glProgramUniform1f(box, at::out_origin, f(-plan.margin[axis] * plan.spacing[axis]));
+    glProgramUniform1f(box, at::view_extent, f(view_size[axis]));
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, size[0], size[1]);
-    set_uniform_int(program(ProgramKind::box), "u_axis", axis);
-    set_uniform(program(ProgramKind::box), "u_cell_size", f(cell));
-    set_uniform(program(ProgramKind::box), "u_out_spacing", f(plan.spacing[axis]));
-    set_uniform(program(ProgramKind::box), "u_box_width", f(plan.box[axis]));
-    glBindTextureUnit(0, input);
+    glProgramUniform1i(box, at::axis, axis);
+    glProgramUniform1f(box, at::cell_size, f(cell));
+    glProgramUniform1f(box, at::out_spacing, f(plan.spacing[axis]));
+    glProgramUniform1f(box, at::box_width, f(plan.box[axis]));
+    glBindTextureUnit(shaders::view_unit, input);
     glDrawArrays(GL_TRIANGLES, 0, 3);
   };
   box_pass(0, t.horizontal_fbo.id(), t.horizontal, plan.block[0]);
@@ -214,30 +178,34 @@ GlCompositor::TextureTransform GlCompositor::prefiltered_transform(const Prefilt
   return t;
 }
 
-// The uniforms of elemental.frag and border_strips.vert: the eye's mapping (DESIGN.md §3), where
-// u_view's texels are, and the region's origin in the target.
-void GlCompositor::set_mapping_uniforms(GLuint p, const EyeMapping& m, const TextureTransform& texture, int x, int y) {
-  set_uniform(p, "u_texture_scale", texture.scale[0], texture.scale[1]);
-  set_uniform(p, "u_texture_offset", texture.offset[0], texture.offset[1]);
-  set_uniform_int(p, "u_cut_outside", texture.cut_outside ? 1 : 0);
-  set_uniform(p, "u_region_origin", f(x), f(y));
-  set_uniform(p, "u_panel", f(m.panel[0]), f(m.panel[1]));
-  set_uniform(p, "u_pixel_pitch", f(m.pixel_pitch_mm.x), f(m.pixel_pitch_mm.y));
-  set_uniform(p, "u_shift", f(m.shift_px.x), f(m.shift_px.y));
-  set_uniform(p, "u_rotation", f(m.rotation_cos), f(m.rotation_sin));
-  set_uniform_int(p, "u_has_lens_array", m.has_lens_array ? 1 : 0);
+// The uniform block of elemental.frag and border_strips.vert (shaders/mapping.glsl): the eye's
+// mapping (DESIGN.md §3), where u_view's texels are, and the region's origin in the target.
+// Rewritten before each draw that reads it (GL orders the update after the draws before).
+void GlCompositor::upload_mapping(const EyeMapping& m, const TextureTransform& texture, int x, int y) {
+  shaders::MappingBlock b;
+  b.texture_scale = {texture.scale[0], texture.scale[1]};
+  b.texture_offset = {texture.offset[0], texture.offset[1]};
+  b.cut_outside = texture.cut_outside ? 1 : 0;
+  b.region_origin = {f(x), f(y)};
+  b.panel = {f(m.panel[0]), f(m.panel[1])};
+  b.pixel_pitch = {f(m.pixel_pitch_mm.x), f(m.pixel_pitch_mm.y)};
+  b.shift = {f(m.shift_px.x), f(m.shift_px.y)};
+  b.rotation = {f(m.rotation_cos), f(m.rotation_sin)};
+  b.has_lens_array = m.has_lens_array ? 1 : 0;
   if (m.has_lens_array) {
-    set_uniform(p, "u_to_lens_plane", f(m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm)));
-    set_uniform(p, "u_lattice_offset", f(m.lattice_offset_mm.x), f(m.lattice_offset_mm.y));
-    set_uniform(p, "u_lens_pitch", f(m.lens_pitch_mm));
-    set_uniform_int(p, "u_first_lens", m.first_lens[0], m.first_lens[1]);
-    set_uniform_int(p, "u_lenses", m.lenses[0], m.lenses[1]);
-    set_uniform(p, "u_chief_ray_scale", f((m.render_distance_mm - m.eye_relief_mm) / m.gap_mm));
-    set_uniform(p, "u_screen_centre", f(m.screen_centre_mm.x), f(m.screen_centre_mm.y));
-    set_uniform(p, "u_screen_size", f(m.screen_size_mm.x), f(m.screen_size_mm.y));
+    b.to_lens_plane = f(m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm));
+    b.lattice_offset = {f(m.lattice_offset_mm.x), f(m.lattice_offset_mm.y)};
+    b.lens_pitch = f(m.lens_pitch_mm);
+    b.first_lens = {m.first_lens[0], m.first_lens[1]};
+    b.lenses = {m.lenses[0], m.lenses[1]};
+    b.chief_ray_scale = f((m.render_distance_mm - m.eye_relief_mm) / m.gap_mm);
+    b.screen_centre = {f(m.screen_centre_mm.x), f(m.screen_centre_mm.y)};
+    b.screen_size = {f(m.screen_size_mm.x), f(m.screen_size_mm.y)};
   } else {
-    set_uniform(p, "u_view_size", f(m.view_size_mm.x), f(m.view_size_mm.y));
+    b.view_size = {f(m.view_size_mm.x), f(m.view_size_mm.y)};
   }
+  glNamedBufferSubData(mapping_block_.id(), 0, sizeof b, &b);
+  glBindBufferBase(GL_UNIFORM_BUFFER, shaders::mapping_block_binding, mapping_block_.id());
 }
 
 // Renders the coordinate map (elemental.frag's mapping, pass 1's tap positions) of `m` into `map`.
@@ -245,11 +213,11 @@ void GlCompositor::draw_coordinate_map(const EyeMapping& m, const TextureTransfo
   map.fbo.reset();
   map.texture = gl::make_texture_2d(GL_RG32F, m.panel[0], m.panel[1]);
   map.fbo = gl::make_framebuffer(map.texture);
-  set_mapping_uniforms(program(ProgramKind::map), m, texture, 0, 0);
+  upload_mapping(m, texture, 0, 0);
   glBindVertexArray(empty_vertex_array_.id());
   glBindFramebuffer(GL_FRAMEBUFFER, map.fbo.id());
   glViewport(0, 0, m.panel[0], m.panel[1]);
-  glUseProgram(program(ProgramKind::map));
+  glUseProgram(program(shaders::ProgramKind::map));
   glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
@@ -294,8 +262,6 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
       use_map && (!coordinate_maps_[e].texture || coordinate_maps_[e].width != view.width ||
                   coordinate_maps_[e].height != view.height || coordinate_maps_[e].aspect != view.aspect());
   const bool border_strips = options_.fsaa != 0 && m.has_lens_array;
-  if (!use_map) set_mapping_uniforms(program(ProgramKind::elemental), m, texture, target.x, target.y);
-  if (border_strips) set_mapping_uniforms(program(ProgramKind::border), m, texture, target.x, target.y);
   glBindVertexArray(empty_vertex_array_.id());
   CoordinateMap& map = coordinate_maps_[e];
   if (new_map) {
@@ -304,21 +270,23 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
     map.height = view.height;
     map.aspect = view.aspect();
   }
+  if (!use_map || border_strips) upload_mapping(m, texture, target.x, target.y);
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   glViewport(target.x, target.y, m.panel[0], m.panel[1]);
-  glBindSampler(0, sampler_.id());
-  glBindTextureUnit(0, source);
+  glBindSampler(shaders::view_unit, sampler_.id());
+  glBindTextureUnit(shaders::view_unit, source);
   if (use_map) {
-    glBindSampler(1, 0);
-    glBindTextureUnit(1, map.texture.id());
-    set_uniform(program(ProgramKind::lookup), "u_region_origin", f(target.x), f(target.y));
-    glUseProgram(program(ProgramKind::lookup));
+    glBindSampler(shaders::second_unit, 0);
+    glBindTextureUnit(shaders::second_unit, map.texture.id());
+    glProgramUniform2f(program(shaders::ProgramKind::lookup), shaders::location::lookup_region_origin, f(target.x),
+                       f(target.y));
+    glUseProgram(program(shaders::ProgramKind::lookup));
   } else {
-    glUseProgram(program(ProgramKind::elemental));
+    glUseProgram(program(shaders::ProgramKind::elemental));
   }
   glDrawArrays(GL_TRIANGLES, 0, 3);
   if (border_strips) {
-    glUseProgram(program(ProgramKind::border));
+    glUseProgram(program(shaders::ProgramKind::border));
     glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
   }
   gl::check_error("rendering an eye image");
@@ -363,16 +331,16 @@ std::optional<CompositeTable::Recording> GlCompositor::record_composite_table(Ey
     // The border strips write down each part's tap instead of taking it, a part per pass.
     const gl::Texture part_texture = gl::make_texture_2d(GL_RGBA32F, width, height);
     const gl::Framebuffer fbo = gl::make_framebuffer(part_texture);
-    set_mapping_uniforms(program(ProgramKind::record), m, texture, 0, 0);
+    upload_mapping(m, texture, 0, 0);
     glBindVertexArray(empty_vertex_array_.id());
     glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
     glViewport(0, 0, width, height);
-    glUseProgram(program(ProgramKind::record));
+    glUseProgram(program(shaders::ProgramKind::record));
     std::vector<float> part(4 * pixels);
     for (int k = 0; k < 4; ++k) {
       const GLfloat zero[4] = {0.f, 0.f, 0.f, 0.f};
       glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, zero);
-      set_uniform_int(program(ProgramKind::record), "u_part", k);
+      glProgramUniform1i(program(shaders::ProgramKind::record), shaders::location::record_part, k);
       glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
       glGetTextureImage(part_texture.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(part.size() * sizeof(float)),
                         part.data());

@@ -20,8 +20,9 @@
 #include <memory>
 #include <optional>
 
-#include "compositor/cpu/composite_table.hpp"
 #include "compositor/compositor.hpp"
+#include "compositor/cpu/composite_table.hpp"
+#include "compositor/gl/shader_programs.hpp"
 #include "core/gl/context.hpp"
 #include "core/gl/egl_context.hpp"
 #include "core/gl/objects.hpp"
@@ -147,7 +148,8 @@ class GlCompositor final : public Compositor {
     bool cut_outside = true;
   };
   static TextureTransform prefiltered_transform(const PrefilterPlan& plan);
-  void set_mapping_uniforms(GLuint program, const EyeMapping& m, const TextureTransform& texture, int x, int y);
+  // Fills the mapping's uniform block (shaders/mapping.glsl) for the next draw.
+  void upload_mapping(const EyeMapping& m, const TextureTransform& texture, int x, int y);
   void draw_coordinate_map(const EyeMapping& m, const TextureTransform& texture, CoordinateMap& map);
   // Runs the prefilter passes; returns the texture the elemental pass samples. `reduced`: the
   // texture already holds the block means (the first pass is skipped).
@@ -160,12 +162,10 @@ class GlCompositor final : public Compositor {
   CompositorOptions options_;
   gl::VertexArray empty_vertex_array_;
   gl::Sampler sampler_;
-  // elemental: pass 1 from the view; border: the strips' area split; map: the coordinate map;
-  // lookup: pass 1 through the map; reduce, box: the prefilter; record: the strips writing down
-  // their taps (record_composite_table).
-  enum class ProgramKind { elemental, border, map, lookup, reduce, box, record };
-  GLuint program(ProgramKind kind);
-  std::array<gl::Program, 7> programs_;
+  gl::Buffer mapping_block_;  // shaders::MappingBlock, bound at shaders::mapping_block_binding
+  // Compiled on first use, from shaders::program_source (compositor/gl/shader_programs.hpp).
+  GLuint program(shaders::ProgramKind kind);
+  std::array<gl::Program, shaders::every_program_kind.size()> programs_;
   std::array<CoordinateMap, 2> coordinate_maps_;       // per eye, fsaa 1
   std::array<PrefilterTargets, 2> prefilter_targets_;  // per eye
   std::array<UploadedView, 2> uploads_;                // per eye, for compose()

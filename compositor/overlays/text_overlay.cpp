@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "compositor/gl/shader_interface.hpp"
+#include "compositor/gl/shader_programs.hpp"
 #include "core/chart_style.hpp"
 #include "core/gl/egl_context.hpp"
 #include "core/image_library.hpp"
@@ -37,13 +39,18 @@ GLenum output_format(GLenum view_format) {
   }
 }
 
+gl::Program make_text_program() {
+  const shaders::ProgramSource source = shaders::program_source(shaders::ProgramKind::text_overlay, 1);
+  return gl::make_program(source.vertex, source.fragment, source.defines);
+}
+
 // Displayed width of one view texel relative to its height (1 for square pixels).
 double pixel_aspect(const GlTextureView& view) { return view.aspect() * view.height / static_cast<double>(view.width); }
 
 }  // namespace
 
 TextOverlay::TextOverlay()
-    : program_(gl::make_program("fullscreen.vert", "text_overlay.frag")),
+    : program_(make_text_program()),
       vertex_array_(gl::make_vertex_array()),
       sampler_(gl::make_linear_clamp_sampler()) {}
 
@@ -177,19 +184,19 @@ GlTextureView TextOverlay::apply(Eye eye, const GlTextureView& view) {
   glDisable(GL_SCISSOR_TEST);
   glDisable(GL_BLEND);
   glUseProgram(program_.id());
-  glProgramUniform2i(program_.id(), glGetUniformLocation(program_.id(), "u_box_origin"), box.x, box.y);
-  glProgramUniform2i(program_.id(), glGetUniformLocation(program_.id(), "u_box_size"), box.width, box.height);
-  glBindTextureUnit(0, view.texture);
-  glBindTextureUnit(1, text->texture.id());
+  glProgramUniform2i(program_.id(), shaders::location::text_box_origin, box.x, box.y);
+  glProgramUniform2i(program_.id(), shaders::location::text_box_size, box.width, box.height);
+  glBindTextureUnit(shaders::view_unit, view.texture);
+  glBindTextureUnit(shaders::second_unit, text->texture.id());
   // Our sampler on both units: texelFetch of the view then works whatever the view texture's own
   // filter (a mipmapped filter on a single-level texture would make it incomplete, reading black).
-  glBindSampler(0, sampler_.id());
-  glBindSampler(1, sampler_.id());
+  glBindSampler(shaders::view_unit, sampler_.id());
+  glBindSampler(shaders::second_unit, sampler_.id());
   glBindVertexArray(vertex_array_.id());
   glDrawArrays(GL_TRIANGLES, 0, 3);
-  glBindSampler(0, 0);
-  glBindSampler(1, 0);
-  glBindTextureUnit(1, 0);
+  glBindSampler(shaders::view_unit, 0);
+  glBindSampler(shaders::second_unit, 0);
+  glBindTextureUnit(shaders::second_unit, 0);
   gl::check_error("drawing the on-screen text");
 
   target.box = box;

@@ -7,18 +7,19 @@
 
 #include "core/embedded.hpp"
 #include "core/gl/egl_context.hpp"
+#include "core/gl/shader_text.hpp"
 
 namespace nelf::gl {
 
 namespace {
 
 Shader compile(GLenum stage, std::string_view name, std::string_view defines) {
-  const auto source = embedded::find(embedded::nelf_embedded_shaders(), name);
-  if (!source) throw GlError(fmt::format("shader {} is not embedded in this build", name));
-  // #version must stay the first line: the defines go right after it.
-  const std::size_t first_line_end = std::min(source->find('\n'), source->size());
-  const std::string text = std::string(source->substr(0, first_line_end)) + "\n" + std::string(defines) +
-                           std::string(source->substr(first_line_end));
+  std::string text;
+  try {
+    text = shader_text(embedded::nelf_embedded_shaders(), name, defines);
+  } catch (const ShaderTextError& e) {
+    throw GlError(e.what());
+  }
   Shader shader(glCreateShader(stage));
   const char* text_pointer = text.c_str();
   const GLint length = static_cast<GLint>(text.size());
@@ -94,6 +95,15 @@ VertexArray make_vertex_array() {
   GLuint id = 0;
   glCreateVertexArrays(1, &id);
   return VertexArray(id);
+}
+
+Buffer make_uniform_buffer(std::size_t bytes) {
+  GLuint id = 0;
+  glCreateBuffers(1, &id);
+  Buffer buffer(id);
+  glNamedBufferStorage(id, static_cast<GLsizeiptr>(bytes), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  check_error("creating a uniform buffer");
+  return buffer;
 }
 
 Sampler make_linear_clamp_sampler() {

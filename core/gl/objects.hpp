@@ -77,10 +77,13 @@ Texture make_bgra8_texture_2d(int width, int height);
 // A framebuffer with `colour` as its only colour attachment; throws GlError when incomplete.
 Framebuffer make_framebuffer(const Texture& colour);
 VertexArray make_vertex_array();
+// A buffer of `bytes` for uniform data, rewritten with glNamedBufferSubData (dynamic storage).
+Buffer make_uniform_buffer(std::size_t bytes);
 // Bilinear, no mipmaps, clamped to the edge: how every view and intermediate texture is read.
 Sampler make_linear_clamp_sampler();
 // Compiles and links the embedded shaders `vertex_name` + `fragment_name` (shaders/*.vert|frag);
-// `defines` (e.g. "#define X\n") goes right after each shader's #version line. Throws GlError with
+// `defines` (e.g. "#define X\n") goes right after each shader's #version line and `#include`
+// lines are spliced in (core/gl/shader_text.hpp). Throws GlError with
 // the info log when that fails.
 Program make_program(std::string_view vertex_name, std::string_view fragment_name, std::string_view defines = {});
 
