@@ -11,6 +11,7 @@ namespace nelf {
 
 // Outputs that are one file with no header of their own declare their opener here, beside their row.
 std::unique_ptr<Display> open_offscreen_display(const DisplayOptions& options);
+std::unique_ptr<Display> open_quad_buffer_display(const DisplayOptions& options);
 
 namespace {
 
@@ -20,8 +21,7 @@ constexpr DisplayDriver kDrivers[] = {
     {"fullscreen", "1:1 on the monitor --monitor names, the HMD by default",
      [](const DisplayOptions& o) { return open_window_display(o, WindowMode::fullscreen); }},
     {"kms", "scan-out on the --connector without a desktop (docs/kms.md)", open_kms_display},
-    {"quad-buffer", "an OpenGL quad-buffer stereo window, an eye in each back buffer",
-     [](const DisplayOptions& o) { return open_window_display(o, WindowMode::quad_buffer); }},
+    {"quad-buffer", "an OpenGL quad-buffer stereo window, an eye in each back buffer", open_quad_buffer_display},
     {"offscreen", "no display: rendered off screen and paced by the clock, for tests and timing",
      open_offscreen_display},
 };

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "compositor/gl/gl_compositor.hpp"
+#include "hmz_output/display_drivers.hpp"
 #include "hmz_output/packing.hpp"
 #include "hmz_output/window_display.hpp"
 #include "optics/profile.hpp"
@@ -184,7 +185,7 @@ TEST_F(WindowDisplayTest, TwoDisplaysInTurnEachGetAWorkingContext) {
 
 TEST_F(WindowDisplayTest, QuadBufferOnMesaSaysThereAreNoStereoVisuals) {
   try {
-    open_window_display(frame_packed_options(), WindowMode::quad_buffer);
+    display_driver("quad-buffer").open(frame_packed_options());
     FAIL() << "Mesa offered a stereo visual";
   } catch (const std::runtime_error& e) {
     const std::string message = e.what();
@@ -436,7 +437,7 @@ TEST(WindowDisplayErrors, QuadBufferNeedsBothEyes) {
   DisplayOptions options = frame_packed_options();
   options.signal = *find_signal("left");
   options.packed = {1280, 720};
-  EXPECT_THROW(open_window_display(options, WindowMode::quad_buffer), std::invalid_argument);
+  EXPECT_THROW(display_driver("quad-buffer").open(options), std::invalid_argument);
 }
 
 }  // namespace
