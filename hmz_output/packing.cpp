@@ -6,15 +6,15 @@
 namespace nelf {
 namespace {
 
-// Copies `eye` into the area_w x area_h area of `frame` at (area_x, area_y), centred 1:1: borders
-// stay as they are (black) when the eye is smaller, the eye is cropped evenly when it is larger.
-void blit_centred(Image& frame, const Image& eye, int area_x, int area_y, int area_w, int area_h) {
-  const int dx = (area_w - eye.width()) / 2, dy = (area_h - eye.height()) / 2;
-  const int x_begin = std::max(0, dx), x_end = std::min(area_w, dx + eye.width());
-  const int y_begin = std::max(0, dy), y_end = std::min(area_h, dy + eye.height());
+// Copies `eye` into `frame` with its top-left corner at `origin`, clipped to `area`: borders stay
+// as they are (black) when the eye is smaller, the eye is cropped evenly when it is larger.
+void blit_centred(Image& frame, const Image& eye, const EyeArea& area, std::pair<int, int> origin) {
+  const int dx = origin.first - area.x, dy = origin.second - area.y;
+  const int x_begin = std::max(0, dx), x_end = std::min(area.width, dx + eye.width());
+  const int y_begin = std::max(0, dy), y_end = std::min(area.height, dy + eye.height());
   for (int y = y_begin; y < y_end; ++y) {
     const Rgba* src = &eye.at(x_begin - dx, y - dy);
-    std::copy(src, src + (x_end - x_begin), &frame.at(area_x + x_begin, area_y + y));
+    std::copy(src, src + (x_end - x_begin), &frame.at(area.x + x_begin, area.y + y));
   }
 }
 
@@ -41,12 +41,26 @@ Image pack_eyes(const Signal& signal, const Image& left, const Image& right) {
   if (left.width() != right.width() || left.height() != right.height())
     throw std::invalid_argument(fmt::format("pack_eyes: eye images differ in size ({}x{} and {}x{})", left.width(),
                                             left.height(), right.width(), right.height()));
-  const int w = left.width(), h = left.height();
-  Image frame(signal.packed_width(w), signal.packed_height(h));  // black, alpha 1
-  for (Eye eye : {Eye::left, Eye::right})
-    if (const auto area = eye_area(signal, eye, w, h))
-      blit_centred(frame, eye == Eye::left ? left : right, area->x, area->y, area->width, area->height);
+  const PackedLayout layout = packed_layout(signal, {left.width(), left.height()});
+  Image frame(layout.packed[0], layout.packed[1]);  // black, alpha 1
+  for (int e = 0; e < 2; ++e)
+    if (layout.areas[e]) blit_centred(frame, e == 0 ? left : right, *layout.areas[e], *layout.origins[e]);
   return frame;
+}
+
+PackedLayout packed_layout(const Signal& signal, std::array<int, 2> eye) {
+  PackedLayout layout;
+  layout.packed = {signal.packed_width(eye[0]), signal.packed_height(eye[1])};
+  layout.eye = eye;
+  for (Eye e : {Eye::left, Eye::right}) {
+    const auto area = eye_area(signal, e, eye[0], eye[1]);
+    if (!area) continue;
+    const int i = static_cast<int>(e);
+    layout.areas[i] = area;
+    // C++ division truncates toward zero: a larger eye is cropped by the same amount on both sides.
+    layout.origins[i] = std::pair{area->x + (area->width - eye[0]) / 2, area->y + (area->height - eye[1]) / 2};
+  }
+  return layout;
 }
 
 }  // namespace nelf

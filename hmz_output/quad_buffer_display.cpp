@@ -38,12 +38,11 @@ std::array<int, 2> eye_size(const DisplayOptions& options) {
 std::array<EyeArea, 2> both_eye_areas(const DisplayOptions& options) {
   if (options.packed[0] <= 0 || options.packed[1] <= 0) return {};  // refused as an empty packed frame
   const auto eye = eye_size(options);
-  const auto left = eye_area(options.signal, Eye::left, eye[0], eye[1]);
-  const auto right = eye_area(options.signal, Eye::right, eye[0], eye[1]);
-  if (!left || !right || eye[0] <= 0 || eye[1] <= 0)
+  const PackedLayout layout = packed_layout(options.signal, eye);
+  if (!layout.areas[0] || !layout.areas[1] || eye[0] <= 0 || eye[1] <= 0)
     throw std::invalid_argument(
         fmt::format("quad-buffer needs a signal carrying both eyes (not {})", options.signal.name));
-  return {*left, *right};
+  return {*layout.areas[0], *layout.areas[1]};
 }
 
 class QuadBufferDisplay final : public glfw::WindowDisplay {

@@ -184,13 +184,12 @@ class Session {
     const GLuint fbo = display_->packed_framebuffer();
     const GLfloat black[4] = {0.f, 0.f, 0.f, 1.f};
     glClearNamedFramebufferfv(fbo, GL_COLOR, 0, black);
-    const auto panel = controls_.profile().display.resolution;
+    const PackedLayout layout = packed_layout(settings_.signal, controls_.profile().display.resolution);
     for (Eye eye : {Eye::left, Eye::right}) {
-      const auto area = eye_area(settings_.signal, eye, panel[0], panel[1]);
-      if (!area) continue;
-      // Centred 1:1 in the eye area, as pack_eyes does for files.
-      const GlTarget target{fbo, area->x + (area->width - panel[0]) / 2, area->y + (area->height - panel[1]) / 2};
-      compositor_->render_eye(eye, overlay_.apply(eye, patterns_.view(eye)), target);
+      const auto& origin = layout.origins[static_cast<int>(eye)];
+      if (!origin) continue;
+      compositor_->render_eye(eye, overlay_.apply(eye, patterns_.view(eye)),
+                              GlTarget{fbo, origin->first, origin->second});
     }
   }
 

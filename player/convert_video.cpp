@@ -256,19 +256,16 @@ class PackedFrameRenderer {
       : signal_(r.signal), view_w_(view_w), view_h_(view_h), bits_(bits), block_(block) {
     validate_fsaa(r.compositor.fsaa);
     const auto panel = panel_ = r.profile.display.resolution;
-    width_ = signal_.packed_width(panel[0]);
-    height_ = signal_.packed_height(panel[1]);
-    for (Eye eye : {Eye::left, Eye::right}) {
-      const auto area = eye_area(signal_, eye, panel[0], panel[1]);
-      if (!area) continue;
-      if (panel[0] > area->width || panel[1] > area->height)
+    const PackedLayout layout = packed_layout(signal_, panel);
+    width_ = layout.packed[0];
+    height_ = layout.packed[1];
+    for (const auto& area : layout.areas)
+      if (area && (panel[0] > area->width || panel[1] > area->height))
         throw UserError(fmt::format("the {}x{} panel of profile {} does not fit the {}x{} eye area of signal {}; "
                                     "use --signal sbs, tab, left or right",
                                     panel[0], panel[1], r.profile.name, area->width, area->height, signal_.name),
                         2);
-      origins_[static_cast<int>(eye)] = {area->x + (area->width - panel[0]) / 2,
-                                         area->y + (area->height - panel[1]) / 2};
-    }
+    origins_ = layout.origins;
     // On a software rasteriser 8-bit block means are composited on the CPU from tables recorded
     // once with the compositor's shaders (compositor/cpu/composite_table.hpp): several times cheaper
     // than llvmpipe's passes. Tables seen before come from the cache without starting GL at all.

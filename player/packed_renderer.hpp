@@ -286,21 +286,21 @@ class PackedRenderer {
     update_wanted_blocks();
     const auto panel = compositor_->panel();
     const auto packed = display_.packed_size();
-    for (Eye eye : {Eye::left, Eye::right}) {
-      const auto area = eye_area(options_.signal, eye, panel[0], panel[1]);
-      origins_[static_cast<int>(eye)].reset();
+    const PackedLayout layout = packed_layout(options_.signal, panel);
+    for (int e = 0; e < 2; ++e) {
+      const auto& area = layout.areas[e];
       if (!area) continue;
       if (panel[0] > area->width || panel[1] > area->height)
         throw UserError(fmt::format("the {}x{} panel of profile {} does not fit the {}x{} eye area of signal {}",
                                     panel[0], panel[1], profile_.name, area->width, area->height, options_.signal.name),
                         2);
-      const int x = area->x + (area->width - panel[0]) / 2, y = area->y + (area->height - panel[1]) / 2;
+      const auto [x, y] = *layout.origins[e];
       if (x + panel[0] > packed[0] || y + panel[1] > packed[1])
         throw UserError(fmt::format("the display's {}x{} frame is smaller than signal {} needs", packed[0], packed[1],
                                     options_.signal.name),
                         1);
-      origins_[static_cast<int>(eye)] = std::pair{x, y};
     }
+    origins_ = layout.origins;
   }
 
   Display& display_;

@@ -122,6 +122,27 @@ TEST(Packing, LargerEyesAreCroppedEvenly) {
   EXPECT_EQ(count_not(frame, 750, 1470, kRight), 0);
 }
 
+TEST(PackedLayout, IsWhereEveryOutputPutsTheEyes) {
+  // The same 1280x720 panel on 1080p24 as above: the areas are the signal's, the origins centred.
+  const PackedLayout fp = packed_layout(signal("hdmi-fp-1080p24"), {1280, 720});
+  EXPECT_EQ(fp.packed, (std::array<int, 2>{1920, 2205}));
+  EXPECT_EQ(fp.eye, (std::array<int, 2>{1280, 720}));
+  ASSERT_TRUE(fp.areas[0] && fp.areas[1]);
+  EXPECT_EQ(fp.areas[1]->y, 1125);
+  EXPECT_EQ(fp.areas[1]->width, 1920);
+  EXPECT_EQ(fp.origins[0], (std::pair{320, 180}));
+  EXPECT_EQ(fp.origins[1], (std::pair{320, 1125 + 180}));
+  // Larger eyes: negative offsets, cropped evenly (pack_eyes above puts (320, 180) at (0, 0)).
+  EXPECT_EQ(packed_layout(signal("hdmi-fp-720p60"), {1920, 1080}).origins[0], (std::pair{-320, -180}));
+  const PackedLayout sbs = packed_layout(signal("sbs"), {640, 360});
+  EXPECT_EQ(sbs.packed, (std::array<int, 2>{1280, 360}));
+  EXPECT_EQ(sbs.origins[1], (std::pair{640, 0}));
+  const PackedLayout right = packed_layout(signal("right"), {640, 360});
+  EXPECT_FALSE(right.areas[0]);
+  EXPECT_FALSE(right.origins[0]);
+  EXPECT_EQ(right.origins[1], (std::pair{0, 0}));
+}
+
 TEST(Packing, PlainOutputs) {
   const Image left = filled(64, 36, kLeft), right = filled(64, 36, kRight);
   const Image sbs = pack_eyes(signal("sbs"), left, right);
