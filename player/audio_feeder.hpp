@@ -1,10 +1,13 @@
 #pragma once
 // The sound of `nelf play`: decoded audio fed to the device ahead of its time.
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <exception>
 #include <mutex>
 #include <optional>
 #include <thread>
+#include <utility>
 
 #include "hmz_output/audio_output.hpp"
 #include "inputs/audio_source.hpp"

@@ -1,0 +1,134 @@
+#include "player/play_commands.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "compositor/gl/gl_compositor.hpp"
+#include "inputs/test_patterns.hpp"
+
+namespace nelf::playback {
+
+ViewBlockChooser view_blocks_for(const Profile& profile, const CompositorOptions& compositor) {
+  return [profile, compositor](int width, int height, double aspect) {
+    return stereo_prefilter_block(profile, compositor, width, height, aspect);
+  };
+}
+
+void PlayCommands::say(std::string text) {
+  state_.dirty = true;
+  if (!options_.on_screen_messages) return;
+  message_ = std::move(text);
+  renderer_.set_message(message_);
+  message_until_ = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+}
+
+void PlayCommands::expire_message() {
+  if (message_.empty() || std::chrono::steady_clock::now() <= message_until_) return;
+  message_.clear();
+  renderer_.set_message("");
+  state_.dirty = true;
+}
+
+void PlayCommands::seek_by(double delta) {
+  PlaybackClock& clock = sound_.clock();
+  const double from = state_.current ? state_.current->pts_s : clock.now();
+  double target = std::max(0.0, from + delta);
+  if (duration_s_) target = std::min(target, std::max(0.0, *duration_s_ - 0.001));
+  queue_.seek(target);
+  sound_.seek(target);
+  clock.restart_at(target);
+  clock.set_paused(true);  // until the first frame after the seek is decoded
+  state_.awaiting_seek = true;
+  scheduler_.reset();
+  say(fmt::format("{} {:.0f} s: {}:{:02d}", delta < 0 ? "back" : "forward", std::abs(delta),
+                  static_cast<int>(target) / 60, static_cast<int>(target) % 60));
+}
+
+void PlayCommands::change_profile(const Profile& changed, const std::string& what) {
+  try {
+    renderer_.set_profile(changed);
+    queue_.reduce_views(view_blocks_for(changed, options_.compositor));
+    state_.dirty = true;
+    say(what);
+  } catch (const std::exception& e) {
+    say(fmt::format("cannot: {}", e.what()));
+  }
+}
+
+bool PlayCommands::apply(Command command) {
+  switch (command) {
+    case Command::quit:
+      return false;
+    case Command::pause:
+      state_.paused = !state_.paused;
+      if (!state_.awaiting_seek && state_.started) sound_.clock().set_paused(state_.paused);
+      say(state_.paused ? "paused" : "playing");
+      break;
+    case Command::seek_back_10s:
+      seek_by(-10);
+      break;
+    case Command::seek_forward_10s:
+      seek_by(10);
+      break;
+    case Command::seek_forward_60s:
+      seek_by(60);
+      break;
+    case Command::seek_back_60s:
+      seek_by(-60);
+      break;
+    case Command::screen_farther:
+    case Command::screen_nearer: {
+      Profile p = renderer_.profile();
+      const double now_mm = p.screen.distance_mm > 0 ? p.screen.distance_mm : p.viewing.virtual_image_mm;
+      p.screen.distance_mm = command == Command::screen_nearer ? now_mm / 1.25 : now_mm * 1.25;
+      change_profile(p, fmt::format("screen distance {:.0f} mm", p.screen.distance_mm));
+      break;
+    }
+    case Command::ipd_narrower:
+    case Command::ipd_wider: {
+      Profile p = renderer_.profile();
+      p.viewing.ipd_mm += command == Command::ipd_narrower ? -0.5 : 0.5;
+      change_profile(p, fmt::format("IPD {:.1f} mm", p.viewing.ipd_mm));
+      break;
+    }
+    case Command::swap_eyes:
+      state_.swap_eyes = !state_.swap_eyes;
+      state_.dirty = true;
+      say(state_.swap_eyes ? "eyes swapped" : "eyes as the source says");
+      break;
+    case Command::calibration_grid:
+      state_.calibration = !state_.calibration;
+      try {
+        if (state_.current) renderer_.upload(state_.current, state_.calibration);
+      } catch (const TestPatternError& e) {
+        state_.calibration = false;
+        if (state_.current) renderer_.upload(state_.current, state_.calibration);
+        say(fmt::format("no calibration grid: {}", e.what()));
+        break;
+      }
+      state_.dirty = true;
+      say(state_.calibration ? "calibration grid on" : "calibration grid off");
+      break;
+    case Command::fullscreen:
+      say(display_.toggle_fullscreen());
+      state_.dirty = true;
+      break;
+    case Command::help: {
+      // Each press shows the next line on screen; the first also prints them all.
+      const std::vector<std::string> lines = key_help(KeyScope::play);
+      if (help_line_ == 0 && !options_.quiet)
+        for (const std::string& line : lines) fmt::print(stderr, "nelf: key {}\n", line);
+      say(lines[help_line_++ % lines.size()]);
+      state_.dirty = true;
+      break;
+    }
+    default:
+      break;  // a calibrate command: not bound in play
+  }
+  return true;
+}
+
+}  // namespace nelf::playback

@@ -1,0 +1,49 @@
+#pragma once
+// The play loop's sense of time per refresh: how long a render takes, and (without vsync) the tick
+// it sleeps to.
+#include <algorithm>
+#include <chrono>
+#include <deque>
+#include <thread>
+#include <vector>
+
+namespace nelf::playback {
+
+// Time from the decision to the end of present(): the median of the last nine renders, so one slow
+// frame on a loaded machine does not make the next ones come early.
+class RenderTime {
+ public:
+  explicit RenderTime(double initial_s) : median_s_(initial_s) {}
+  void add(double seconds) {
+    recent_.push_back(seconds);
+    if (recent_.size() > 9) recent_.pop_front();
+    std::vector<double> sorted(recent_.begin(), recent_.end());
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    median_s_ = sorted[sorted.size() / 2];
+  }
+  double median_s() const { return median_s_; }
+
+ private:
+  std::deque<double> recent_;
+  double median_s_;
+};
+
+// Without vsync nothing paces the loop but this: a tick every refresh period, slept to.
+class RefreshTicker {
+ public:
+  using Steady = std::chrono::steady_clock;
+  explicit RefreshTicker(double period_s)
+      : period_(std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(period_s))) {}
+  void sleep_to_next() {
+    next_ += period_;
+    const auto now = Steady::now();
+    if (next_ < now - std::chrono::milliseconds(100)) next_ = now;  // far behind: do not race
+    std::this_thread::sleep_until(next_);
+  }
+
+ private:
+  Steady::duration period_;
+  Steady::time_point next_ = Steady::now();
+};
+
+}  // namespace nelf::playback
