@@ -10,10 +10,24 @@ extern "C" {
 #include <libswscale/swscale.h>
 }
 
+#include <cstring>
 #include <memory>
 #include <string>
+#include <type_traits>
 
 namespace nelf::ffmpeg {
+
+// The value of an FFmpeg enum field as the integer it holds. FFmpeg copies tags from the bitstream
+// unchecked (an H.264 VUI may say colour matrix 84), and a newer FFmpeg at run time may store a
+// value these headers do not list: loading such a field as its enum type is undefined behaviour in
+// C++ (fuzzing found both, docs/fuzzing.md findings 1 and 8); reading its bytes is not.
+template <typename Enum>
+std::underlying_type_t<Enum> raw_value(const Enum& field) {
+  static_assert(std::is_enum_v<Enum>);
+  std::underlying_type_t<Enum> value{};
+  std::memcpy(&value, &field, sizeof value);
+  return value;
+}
 
 struct FormatContextDeleter {
   // avformat_close_input also frees the context and closes the AVIOContext it opened.

@@ -2,14 +2,13 @@
 
 #include <fmt/format.h>
 
-#include <cstring>
-#include <type_traits>
-
 extern "C" {
 #include <libavformat/avformat.h>
 #include <libavutil/frame.h>
 #include <libavutil/stereo3d.h>
 }
+
+#include "core/ffmpeg_raii.hpp"
 
 namespace nelf {
 
@@ -62,13 +61,8 @@ namespace {
 std::optional<StereoMetadata> from_av(const AVStereo3D& stereo) {
   StereoMetadata metadata;
   metadata.inverted = (stereo.flags & AV_STEREO3D_FLAG_INVERT) != 0;
-  // The type is read as the integer it is in memory: a newer FFmpeg at run time than the headers of
-  // this build may store a type they do not list, and loading that as the enum is undefined
-  // behaviour in C++ (found by tests/fuzz/fuzz_stereo_metadata).
-  std::underlying_type_t<AVStereo3DType> type = 0;
-  static_assert(sizeof type == sizeof stereo.type);
-  std::memcpy(&type, &stereo.type, sizeof type);
-  switch (type) {
+  // A newer FFmpeg at run time than the headers of this build may store a type they do not list.
+  switch (ffmpeg::raw_value(stereo.type)) {
     case AV_STEREO3D_2D:
       metadata.packing = StereoPacking::mono;
       break;

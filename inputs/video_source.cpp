@@ -85,18 +85,6 @@ int rotation_from_display_matrix(const AVStream& stream) {
   return static_cast<int>(((quarter_turns % 4) + 4) % 4) * 90;
 }
 
-// The value of an FFmpeg enum field as the integer it holds. Decoders and demuxers copy colour
-// tags from the bitstream unchecked (an H.264 VUI may say matrix 84): loading such a field as its
-// enum type is undefined behaviour in C++ (found by fuzzing, docs/fuzzing.md finding 8), reading
-// its bytes is not.
-template <typename Enum>
-int raw_value(const Enum& field) {
-  static_assert(sizeof(Enum) == sizeof(int));
-  int value = 0;
-  std::memcpy(&value, &field, sizeof value);
-  return value;
-}
-
 ColorMatrix matrix_from_av(int space, bool& tagged) {
   tagged = true;
   switch (space) {
