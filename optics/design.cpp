@@ -36,27 +36,6 @@ std::string pad_left(const std::string& s, std::size_t width) {
 
 }  // namespace
 
-optics::AxisGeometry axis_geometry(const Profile& profile, int axis) {
-  optics::AxisGeometry g;
-  g.display_mm = axis == 0 ? profile.display.width_mm() : profile.display.height_mm();
-  g.pixel_pitch_mm = axis == 0 ? profile.display.pixel_pitch_mm.x : profile.display.pixel_pitch_mm.y;
-  g.eye_relief_mm = profile.viewing.eye_relief_mm;
-  g.image_mm = profile.viewing.virtual_image_mm;
-  if (profile.lens_array) {
-    g.lens_pitch_mm = profile.lens_array->pitch_mm;
-    g.focal_mm = profile.lens_array->focal_length_mm;
-    // The gap the compositor uses (lens_gap_mm): the hardware's when the profile fixes it; left
-    // empty otherwise so that the optics functions apply Eq. 1 and Eq. 2 exactly.
-    g.gap_mm = profile.lens_array->gap_mm;
-  } else if (profile.magnifier) {
-    g.lens_pitch_mm = profile.magnifier->width_mm;
-    g.focal_mm = profile.magnifier->focal_length_mm;
-  } else {
-    throw std::logic_error("axis_geometry: profile '" + profile.name + "' has neither a lens array nor a magnifier");
-  }
-  return g;
-}
-
 DesignReport design_report(const Profile& profile) {
   DesignReport r;
   r.profile = profile.name;

@@ -70,10 +70,6 @@ struct DesignReport {
   double comparison_eye_box_mm = 0.0;
 };
 
-// The per-axis geometry of `profile` along axis 0 (horizontal) or 1 (vertical), for its lens array
-// or magnifier. Throws std::logic_error when the profile has neither.
-optics::AxisGeometry axis_geometry(const Profile& profile, int axis);
-
 DesignReport design_report(const Profile& profile);
 
 // The JSON object `nelf design --json` prints: optical figures are null when unknown, a depth of

@@ -24,18 +24,6 @@ Vec2 rotate(const EyeMapping& m, Vec2 v, double sign) {
 
 double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
-optics::AxisGeometry axis_geometry(const Profile& p, int axis) {
-  optics::AxisGeometry g;
-  g.display_mm = axis == 0 ? p.display.width_mm() : p.display.height_mm();
-  g.pixel_pitch_mm = axis == 0 ? p.display.pixel_pitch_mm.x : p.display.pixel_pitch_mm.y;
-  g.lens_pitch_mm = p.lens_array->pitch_mm;
-  g.focal_mm = p.lens_array->focal_length_mm;
-  g.eye_relief_mm = p.viewing.eye_relief_mm;
-  g.image_mm = p.viewing.virtual_image_mm;
-  g.gap_mm = p.lens_array->gap_mm;
-  return g;
-}
-
 }  // namespace
 
 double lens_gap_mm(const Profile& profile) {

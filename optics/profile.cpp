@@ -230,23 +230,6 @@ class Reader {
   std::string origin_;
 };
 
-optics::AxisGeometry optics_axis(const Profile& p, int axis) {
-  optics::AxisGeometry g;
-  g.display_mm = axis == 0 ? p.display.width_mm() : p.display.height_mm();
-  g.pixel_pitch_mm = axis == 0 ? p.display.pixel_pitch_mm.x : p.display.pixel_pitch_mm.y;
-  g.eye_relief_mm = p.viewing.eye_relief_mm;
-  g.image_mm = p.viewing.virtual_image_mm;
-  if (p.lens_array) {
-    g.lens_pitch_mm = p.lens_array->pitch_mm;
-    g.focal_mm = p.lens_array->focal_length_mm;
-    g.gap_mm = p.lens_array->gap_mm;
-  } else {
-    g.lens_pitch_mm = p.magnifier->width_mm;
-    g.focal_mm = p.magnifier->focal_length_mm;
-  }
-  return g;
-}
-
 // The figures `nelf design` reports and the compositor builds on, bounded (docs/profiles.md,
 // "Limits"): the lens count by the panel's pixels, a field of view strictly between 0 and 180
 // degrees, at least one resolvable pixel, no more views in the pupil than lenses, and every figure
@@ -258,7 +241,7 @@ void check_derived_figures(const Reader& r, const Profile& p) {
   constexpr const char* axis_names[2] = {"horizontal", "vertical"};
   int lenses_across = 1;
   for (int axis = 0; axis < 2; ++axis) {
-    const optics::AxisGeometry g = optics_axis(p, axis);
+    const optics::AxisGeometry g = axis_geometry(p, axis);
     const char* axis_name = axis_names[axis];
     const int panel_px = p.display.resolution[static_cast<std::size_t>(axis)];
     if (lens_array) {
@@ -592,6 +575,25 @@ std::string profile_to_toml(const Profile& p) {
   out += fmt::format("\n[magnifier_comparison]\neye_box_mm = {}\nf_number = {}\n", p.magnifier_comparison.eye_box_mm,
                      p.magnifier_comparison.f_number);
   return out;
+}
+
+optics::AxisGeometry axis_geometry(const Profile& profile, int axis) {
+  optics::AxisGeometry g;
+  g.display_mm = axis == 0 ? profile.display.width_mm() : profile.display.height_mm();
+  g.pixel_pitch_mm = axis == 0 ? profile.display.pixel_pitch_mm.x : profile.display.pixel_pitch_mm.y;
+  g.eye_relief_mm = profile.viewing.eye_relief_mm;
+  g.image_mm = profile.viewing.virtual_image_mm;
+  if (profile.lens_array) {
+    g.lens_pitch_mm = profile.lens_array->pitch_mm;
+    g.focal_mm = profile.lens_array->focal_length_mm;
+    g.gap_mm = profile.lens_array->gap_mm;
+  } else if (profile.magnifier) {
+    g.lens_pitch_mm = profile.magnifier->width_mm;
+    g.focal_mm = profile.magnifier->focal_length_mm;
+  } else {
+    throw std::logic_error("axis_geometry: profile '" + profile.name + "' has neither a lens array nor a magnifier");
+  }
+  return g;
 }
 
 }  // namespace nelf

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "optics/optics.hpp"
+
 namespace nelf {
 
 // A problem with a profile. what() is one line naming the file, the key, the value and the rule.
@@ -102,6 +104,12 @@ struct BuiltinProfileInfo {
   std::string description;
 };
 std::vector<BuiltinProfileInfo> builtin_profiles();
+
+// The per-axis geometry of `profile` along axis 0 (horizontal) or 1 (vertical), for its lens array
+// or magnifier: what the optics of DESIGN.md §2 (optics/optics.hpp) compute from. The gap is the
+// hardware's when the profile fixes it, left empty otherwise so that the optics functions apply
+// Eq. 1 and Eq. 2 exactly. Throws std::logic_error when the profile has neither.
+optics::AxisGeometry axis_geometry(const Profile& profile, int axis);
 
 // Serialises a profile back to TOML (every key, explicit values) so that parse_profile reads it back equal.
 std::string profile_to_toml(const Profile& profile);
