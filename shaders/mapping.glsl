@@ -2,8 +2,8 @@
 // border_strips.vert (nelf splices `#include` lines itself; GL drivers have no include).
 //
 // One std140 block, mirrored field for field by nelf::shader::MappingBlock
-// (compositor/gl/shader_interface.hpp, whose offsets are static_asserted; tests/gl checks them
-// against the linked program). Keep both in the same order.
+// (compositor/gl/shader_interface.hpp, whose offsets are static_asserted; tests/compositor/gl
+// checks them against the linked program). Keep both in the same order.
 layout(std140, binding = 0) uniform Mapping {
   vec2 u_texture_scale;    // u_view coordinate = uv * scale + offset: the prefiltered
   vec2 u_texture_offset;   // texture extends beyond the screen (black margin)

@@ -11,7 +11,7 @@
 // border strips writing down their taps instead of taking them), so the geometry has one source;
 // this class only replays the box pass and the taps, with the arithmetic of GL's RGBA8 path
 // (8-bit intermediates, 8-bit bilinear weights). It agrees with the GL path to within a code value
-// or two (tests/gl/test_composite_table.cpp).
+// or two (tests/compositor/gl/test_composite_table.cpp).
 #include <array>
 #include <cstddef>
 #include <cstdint>

@@ -1,7 +1,7 @@
 #pragma once
 // What the compositor's shaders declare with layout(...) qualifiers, mirrored in C++: the mapping's
 // uniform block (shaders/mapping.glsl), texture units and uniform locations. No uniform is looked
-// up by name; tests/gl/test_shader_interface.cpp checks this file against the linked programs.
+// up by name; tests/compositor/gl/test_shader_interface.cpp checks this file against the linked programs.
 #include <array>
 #include <cstddef>
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include "x11_close_window.hpp"
+#include "support/x11_close_window.hpp"
 
 #include <X11/Xlib.h>
 

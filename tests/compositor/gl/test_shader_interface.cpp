@@ -11,7 +11,7 @@
 #include "compositor/gl/shader_interface.hpp"
 #include "compositor/gl/shader_programs.hpp"
 #include "core/gl/objects.hpp"
-#include "gl/gl_test_support.hpp"
+#include "support/gl_test_support.hpp"
 
 namespace nelf {
 namespace {

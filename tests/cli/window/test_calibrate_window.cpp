@@ -20,8 +20,8 @@
 #include "optics/profile.hpp"
 #include "support/image_files.hpp"
 #include "support/test_support.hpp"
+#include "support/x11_close_window.hpp"
 #include "support/xvfb.hpp"
-#include "window/x11_close_window.hpp"
 
 namespace nelf {
 namespace {

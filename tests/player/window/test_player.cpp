@@ -20,8 +20,8 @@
 
 #include "compositor/gl/gl_compositor.hpp"
 #include "hmz_output/packing.hpp"
-#include "player/player.hpp"
 #include "hmz_output/window_display.hpp"
+#include "player/player.hpp"
 #include "support/media.hpp"
 #include "support/test_support.hpp"
 #include "support/x11_window.hpp"

@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "optics/design.hpp"
 #include "analysis/design_plot.hpp"
+#include "optics/design.hpp"
 #include "support/test_support.hpp"
 
 namespace nelf {

@@ -1,4 +1,4 @@
-#include "gl/gl_test_support.hpp"
+#include "support/gl_test_support.hpp"
 
 #include <algorithm>
 #include <cmath>

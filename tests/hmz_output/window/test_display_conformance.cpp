@@ -54,7 +54,7 @@ TEST_P(DisplayConformance, OpensAndKeepsTheContractOrRefusesInOneLine) {
   ASSERT_TRUE(opens_here().count(std::string(driver.name)))
       << "a new output: say here whether it opens on Xvfb with Mesa";
   if (driver.name == "kms" && has_drm_device())
-    GTEST_SKIP() << "a DRM device is here: what KMS does then depends on it (tests/unit/test_kms_*.cpp cover its "
+    GTEST_SKIP() << "a DRM device is here: what KMS does then depends on it (tests/hmz_output/test_kms_*.cpp cover its "
                     "choices and errors)";
   const DisplayOptions options = frame_packed_options();
   std::unique_ptr<Display> display;

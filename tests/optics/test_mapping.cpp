@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "optics/mapping.hpp"
 #include "compositor/reference.hpp"
+#include "optics/mapping.hpp"
 
 namespace nelf {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "compositor/gl/gl_compositor.hpp"
 #include "compositor/reference.hpp"
-#include "gl/gl_test_support.hpp"
+#include "support/gl_test_support.hpp"
 
 namespace nelf {
 namespace {

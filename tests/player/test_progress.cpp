@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <thread>
 
-#include "player/progress.hpp"
 #include "core/bounded_queue.hpp"
+#include "player/progress.hpp"
 
 namespace nelf {
 namespace {

@@ -5,9 +5,9 @@
 #include <cmath>
 #include <numbers>
 
+#include "inputs/test_patterns.hpp"
 #include "optics/mapping.hpp"
 #include "optics/profile.hpp"
-#include "inputs/test_patterns.hpp"
 
 namespace nelf {
 namespace {

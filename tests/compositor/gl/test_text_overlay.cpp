@@ -7,9 +7,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "compositor/overlays/text_overlay.hpp"
-#include "gl/gl_test_support.hpp"
 #include "compositor/overlays/calibration_overlay.hpp"
+#include "compositor/overlays/text_overlay.hpp"
+#include "support/gl_test_support.hpp"
 
 namespace nelf {
 namespace {

@@ -2,9 +2,9 @@
 // would be saved loads back with the adjusted values.
 #include <gtest/gtest.h>
 
-#include "player/calibration_controls.hpp"
-#include "optics/mapping.hpp"
 #include "compositor/reference.hpp"
+#include "optics/mapping.hpp"
+#include "player/calibration_controls.hpp"
 #include "support/test_support.hpp"
 
 namespace nelf {

@@ -1,5 +1,5 @@
 // CompositeTable's replay on the CPU against a plain double-precision reference of what it replays
-// (no GL here: tests/gl/test_composite_table.cpp compares it with the GL path itself). The panel is
+// (no GL here: tests/compositor/gl/test_composite_table.cpp compares it with the GL path itself). The panel is
 // 39 pixels wide so that every loop of pass 1 runs: four pixels at a time (AVX2), two (SSE2), one.
 #include <gtest/gtest.h>
 

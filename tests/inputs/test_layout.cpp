@@ -264,7 +264,7 @@ TEST(StereoLayout, JpsIsRightLeftSideBySide) {
   EXPECT_FALSE(detect_stereo_layout({std::nullopt, std::nullopt, 2048, 768, "photo.jpg"}).swap_eyes);
 }
 
-// Merged from the video side's chain (formerly tests/unit/test_layout_chain.cpp).
+// Merged from the video side's chain (formerly tests/unit/test_layout_chain.cpp, since moved).
 LayoutEvidence plain(int width, int height, std::string path = "movie.mkv") {
   LayoutEvidence e;
   e.width = width;

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "compositor/gl/gl_compositor.hpp"
-#include "gl/gl_test_support.hpp"
+#include "support/gl_test_support.hpp"
 
 namespace nelf {
 namespace {
