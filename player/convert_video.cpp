@@ -29,7 +29,6 @@ extern "C" {
 #include "hmz_output/frame_sink.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
-#include "inputs/file_carried_streams.hpp"
 #include "inputs/stereo_frame_source.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
@@ -41,16 +40,16 @@ namespace nelf {
 
 namespace {
 
+// An encoded video file, with the source's own streams copied when it has them (a file's audio,
+// subtitles and chapters), else its decoded sound (the synthetic clip's tone) encoded.
 class EncodedFileSink final : public FrameSink {
  public:
-  EncodedFileSink(const VideoConvertRequest& r, StereoFrameSource& source, int width, int height, int bits,
-                  double origin_s)
-      : source_(source), output_(r.output) {
-    if (!source.audio_path().empty() && r.encoder.audio)
-      carried_ = open_file_carried_streams(source.audio_path(), origin_s, r.allow_network);
+  EncodedFileSink(const VideoConvertRequest& r, std::unique_ptr<CarriedStreams> carried,
+                  std::unique_ptr<AudioStream> audio, int width, int height, int bits, double frame_rate)
+      : output_(r.output), frame_rate_(frame_rate), carried_(std::move(carried)), audio_(std::move(audio)) {
     EncoderSettings settings = r.encoder;
     settings.bits = bits;
-    const AVRational rate = av_d2q(source.frame_rate(), 100000);
+    const AVRational rate = av_d2q(frame_rate, 100000);
     try {
       encoder_.emplace(r.output, width, height, rate.num, rate.den, settings, carried_ ? &carried_->layout() : nullptr);
     } catch (const std::invalid_argument& e) {
@@ -58,27 +57,17 @@ class EncodedFileSink final : public FrameSink {
     } catch (const std::runtime_error& e) {
       throw UserError(e.what(), 1);
     }
-    if (source.has_generated_audio() && r.encoder.audio) {
-      encoder_->add_audio_track(source.generated_audio_rate(), 1);
-      generated_rate_ = source.generated_audio_rate();
-    }
+    if (audio_) encoder_->add_audio_track(audio_->sample_rate(), audio_->channels());
     if (carried_) carried_indices_ = encoder_->carried_streams();
     end_s_ = r.duration_s;
   }
   void write(const PackedFrame& frame) override {
     encoder_->write_video(frame);
-    last_end_s_ = frame.pts_seconds + 1.0 / source_.frame_rate();
+    last_end_s_ = frame.pts_seconds + 1.0 / frame_rate_;
     // Only what starts before this frame ends: the conversion may stop at any frame (--frames, a
     // damaged input), and audio already written past that point could not be taken back.
     carry_until(last_end_s_ - 1e-6, end_s_);
-    if (generated_rate_ > 0) {
-      const auto until = static_cast<std::int64_t>(std::llround(last_end_s_ * generated_rate_));
-      if (until > audio_written_) {
-        const auto samples = source_.generated_audio(audio_written_, static_cast<int>(until - audio_written_));
-        encoder_->write_audio(samples.data(), static_cast<int>(samples.size()));
-        audio_written_ = until;
-      }
-    }
+    if (audio_) encode_audio_until(std::llround(last_end_s_ * audio_->sample_rate()));
   }
   void finish() override {
     // Audio ends with the video (what was converted), not with the source.
@@ -94,16 +83,40 @@ class EncodedFileSink final : public FrameSink {
     while (auto packet = carried_->next_packet(carried_indices_, until_s, end_s))
       encoder_->write_source_packet(packet.get(), packet->stream_index);
   }
+  // The decoded sound up to its first `until` sample frames in all (a stream that ends early ends
+  // the track there). It follows on from 0 as the chunks come; their own times are not read.
+  void encode_audio_until(std::int64_t until) {
+    while (audio_written_ < until) {
+      if (pending_offset_ >= pending_.frames()) {
+        std::optional<AudioChunk> chunk;
+        try {
+          chunk = audio_->next();
+        } catch (const AudioError& e) {
+          throw UserError(e.what(), 1);
+        }
+        if (!chunk) return;
+        pending_ = std::move(*chunk);
+        pending_offset_ = 0;
+        continue;
+      }
+      const std::int64_t count = std::min(until - audio_written_, pending_.frames() - pending_offset_);
+      encoder_->write_audio(pending_.samples.data() + pending_offset_ * pending_.channels, static_cast<int>(count));
+      pending_offset_ += count;
+      audio_written_ += count;
+    }
+  }
 
-  StereoFrameSource& source_;
   std::string output_;
+  double frame_rate_;
   std::unique_ptr<CarriedStreams> carried_;
   std::vector<int> carried_indices_;  // what the encoder carries of carried_
+  std::unique_ptr<AudioStream> audio_;
+  AudioChunk pending_;  // decoded and not all encoded yet, from pending_offset_ on
+  std::int64_t pending_offset_ = 0;
   std::optional<VideoEncoder> encoder_;
   std::optional<double> end_s_;
   double last_end_s_ = 0.0;
-  int generated_rate_ = 0;
-  std::int64_t audio_written_ = 0;
+  std::int64_t audio_written_ = 0;  // sample frames
 };
 
 // frames_%05d.png: one image per frame. Written files are removed again unless finish() is reached.
@@ -378,7 +391,14 @@ constexpr FrameSinkDriver kFrameSinks[] = {
      }},
     {"encoded", [](const std::string&) { return true; },
      [](const FrameSinkContext& c) -> std::unique_ptr<FrameSink> {
-       return std::make_unique<EncodedFileSink>(c.request, c.source, c.width, c.height, c.bits, c.source.origin_s());
+       std::unique_ptr<CarriedStreams> carried;
+       std::unique_ptr<AudioStream> audio;
+       if (c.request.encoder.audio) {
+         carried = c.source.open_carried_streams();
+         if (!carried) audio = c.source.open_audio({}).stream;
+       }
+       return std::make_unique<EncodedFileSink>(c.request, std::move(carried), std::move(audio), c.width, c.height,
+                                                c.bits, c.source.frame_rate());
      }},
 };
 
