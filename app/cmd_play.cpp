@@ -59,7 +59,6 @@ void run_play(const PlayArgs& args) {
   options.signal = common.signal;
   options.compositor = common.compositor;
   options.audio = !args.no_audio;
-  options.allow_network = args.allow_network;
   options.log_frames = args.log_frames;
   options.quiet = args.quiet;
 

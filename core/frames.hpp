@@ -34,11 +34,12 @@ struct PackedFrame {
   double pts_seconds = 0.0;
 };
 
-// Interleaved stereo float samples (L R L R …), −1..1.
+// Interleaved float samples (stereo: L R L R …), −1..1.
 struct AudioChunk {
   double pts_s = 0.0;  // time of the first sample
   std::vector<float> samples;
-  std::int64_t frames() const { return static_cast<std::int64_t>(samples.size() / 2); }
+  int channels = 2;
+  std::int64_t frames() const { return static_cast<std::int64_t>(samples.size()) / channels; }
 };
 
 }  // namespace nelf

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 namespace nelf {
@@ -110,6 +111,7 @@ std::string AudioOutput::description() const {
 }
 
 void AudioOutput::queue(const AudioChunk& chunk) {
+  if (chunk.channels != 2) throw std::logic_error("AudioOutput::queue: the device plays stereo chunks only");
   if (chunk.samples.empty()) return;
   std::lock_guard lock(mutex_);
   if (queued_end_pts_) {

@@ -1,10 +1,11 @@
 #include "hmz_output/video_encoder.hpp"
 
-#include "hmz_output/rgba_to_yuv.hpp"
 #include "core/ffmpeg_raii.hpp"
+#include "hmz_output/rgba_to_yuv.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>
+#include <algorithm>
 #include <functional>
 #include <stdexcept>
 #include <system_error>
@@ -270,7 +271,7 @@ struct VideoEncoder::State {
 };
 
 VideoEncoder::VideoEncoder(const std::filesystem::path& output, int width, int height, int frame_rate_num,
-                           int frame_rate_den, const EncoderSettings& settings, AVFormatContext* source)
+                           int frame_rate_den, const EncoderSettings& settings, const CarriedStreamLayout* carried)
     : state_(std::make_unique<State>()) {
   State& s = *state_;
   s.output = output;
@@ -332,56 +333,59 @@ VideoEncoder::VideoEncoder(const std::filesystem::path& output, int width, int h
   s.video_stream->avg_frame_rate = c.framerate;
 
   // Carry the source's audio and subtitle streams, chapters and metadata where the container takes them.
-  if (source) {
-    s.stream_map.assign(source->nb_streams, -1);
-    for (unsigned i = 0; i < source->nb_streams; ++i) {
-      const AVStream* in = source->streams[i];
-      s.source_time_bases.push_back(in->time_base);
-      const AVMediaType type = in->codecpar->codec_type;
+  if (carried) {
+    int last_index = -1;
+    for (const CarriedStream& in : carried->streams) last_index = std::max(last_index, in.index);
+    const auto slots = static_cast<std::size_t>(last_index + 1);
+    s.stream_map.assign(slots, -1);
+    s.source_time_bases.assign(slots, AVRational{0, 1});
+    for (const CarriedStream& in : carried->streams) {
+      const auto i = static_cast<std::size_t>(in.index);
+      s.source_time_bases[i] = in.time_base;
+      const AVMediaType type = in.codec->codec_type;
       if (type == AVMEDIA_TYPE_AUDIO && !settings.audio) continue;
       if (type != AVMEDIA_TYPE_AUDIO && type != AVMEDIA_TYPE_SUBTITLE) continue;
-      if (avformat_query_codec(format, in->codecpar->codec_id, FF_COMPLIANCE_NORMAL) != 1) {
+      if (avformat_query_codec(format, in.codec->codec_id, FF_COMPLIANCE_NORMAL) != 1) {
         if (type == AVMEDIA_TYPE_AUDIO) {
           // The container cannot hold this audio codec: decode it and re-encode it as AAC.
-          s.reencoded.resize(source->nb_streams);
+          s.reencoded.resize(slots);
           auto re = std::make_unique<ReencodedStream>();
-          const AVCodec* decoder = avcodec_find_decoder(in->codecpar->codec_id);
+          const AVCodec* decoder = avcodec_find_decoder(in.codec->codec_id);
           if (decoder) {
             re->decoder.reset(avcodec_alloc_context3(decoder));
-            avcodec_parameters_to_context(re->decoder.get(), in->codecpar);
-            re->decoder->pkt_timebase = in->time_base;
+            avcodec_parameters_to_context(re->decoder.get(), in.codec.get());
+            re->decoder->pkt_timebase = in.time_base;
           }
           if (decoder && avcodec_open2(re->decoder.get(), decoder, nullptr) >= 0) {
             re->track = std::make_unique<AudioTrack>(s.muxer.get(), re->decoder->sample_rate, re->decoder->ch_layout);
-            av_dict_copy(&re->track->stream()->metadata, in->metadata, 0);
-            re->track->stream()->disposition = in->disposition;
+            av_dict_copy(&re->track->stream()->metadata, in.metadata.get(), 0);
+            re->track->stream()->disposition = in.disposition;
             s.stream_map[i] = re->track->stream()->index;
             s.reencoded[i] = std::move(re);
             continue;
           }
         }
         fmt::print(stderr, "nelf: warning: {} stream {} ({}) cannot be stored in {}: dropped (use .mkv to keep it)\n",
-                   av_get_media_type_string(type), i, avcodec_get_name(in->codecpar->codec_id), format->name);
+                   av_get_media_type_string(type), in.index, avcodec_get_name(in.codec->codec_id), format->name);
         continue;
       }
       AVStream* out = avformat_new_stream(s.muxer.get(), nullptr);
-      avcodec_parameters_copy(out->codecpar, in->codecpar);
+      avcodec_parameters_copy(out->codecpar, in.codec.get());
       out->codecpar->codec_tag = 0;
-      out->time_base = in->time_base;
-      out->disposition = in->disposition;
-      av_dict_copy(&out->metadata, in->metadata, 0);  // language tags, titles
+      out->time_base = in.time_base;
+      out->disposition = in.disposition;
+      av_dict_copy(&out->metadata, in.metadata.get(), 0);  // language tags, titles
       s.stream_map[i] = out->index;
     }
-    av_dict_copy(&s.muxer->metadata, source->metadata, 0);
-    if (source->nb_chapters > 0) {
-      s.muxer->chapters = static_cast<AVChapter**>(av_calloc(source->nb_chapters, sizeof(AVChapter*)));
+    av_dict_copy(&s.muxer->metadata, carried->metadata.get(), 0);
+    if (!carried->chapters.empty()) {
+      s.muxer->chapters = static_cast<AVChapter**>(av_calloc(carried->chapters.size(), sizeof(AVChapter*)));
       if (!s.muxer->chapters) throw std::bad_alloc();
-      for (unsigned i = 0; i < source->nb_chapters; ++i) {
-        const AVChapter* in = source->chapters[i];
+      for (const CarriedChapter& in : carried->chapters) {
         auto* out = static_cast<AVChapter*>(av_mallocz(sizeof(AVChapter)));
         if (!out) throw std::bad_alloc();
-        *out = {in->id, in->time_base, in->start, in->end, nullptr};
-        av_dict_copy(&out->metadata, in->metadata, 0);
+        *out = {in.id, in.time_base, in.start, in.end, nullptr};
+        av_dict_copy(&out->metadata, in.metadata.get(), 0);
         s.muxer->chapters[s.muxer->nb_chapters++] = out;
       }
     }

@@ -1,8 +1,9 @@
 #pragma once
 // The encoder sink: packed RGBA frames in, a video file out (FFmpeg), with the source's audio,
-// subtitle and chapter streams carried over where the container takes them. The file is written
-// under a temporary name in the destination directory and renamed by finish(); an encoder that is
-// destroyed unfinished (error, Ctrl-C) removes its temporary file, so no half-written output remains.
+// subtitle and chapter streams (core/carried_streams.hpp) carried over where the container takes
+// them. The file is written under a temporary name in the destination directory and renamed by
+// finish(); an encoder that is destroyed unfinished (error, Ctrl-C) removes its temporary file, so
+// no half-written output remains.
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -10,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "core/carried_streams.hpp"
 #include "core/frames.hpp"
 
-struct AVFormatContext;
 struct AVPacket;
 
 namespace nelf {
@@ -28,16 +29,18 @@ struct EncoderSettings {
 
 class VideoEncoder {
  public:
-  // `source` (optional) is the opened input whose non-video streams are carried over; `frame_rate`
-  // is the nominal rate (num/den) used as the stream's rate; timestamps come from each frame.
+  // `carried` (optional): the source's streams, chapters and metadata to carry over (its packets
+  // then come through write_source_packet); `frame_rate` is the nominal rate (num/den) used as the
+  // stream's rate; timestamps come from each frame.
   VideoEncoder(const std::filesystem::path& output, int width, int height, int frame_rate_num, int frame_rate_den,
-               const EncoderSettings& settings, AVFormatContext* source = nullptr);
+               const EncoderSettings& settings, const CarriedStreamLayout* carried = nullptr);
   ~VideoEncoder();
   VideoEncoder(const VideoEncoder&) = delete;
   VideoEncoder& operator=(const VideoEncoder&) = delete;
 
   void write_video(const PackedFrame& frame);
-  // A packet of source stream `source_stream` (audio/subtitle); ignored when that stream is not carried.
+  // A packet of source stream `source_stream` (CarriedStream::index) in that stream's time base;
+  // ignored when that stream is not carried.
   void write_source_packet(AVPacket* packet, int source_stream);
   // A generated audio track (e.g. the synthetic source's tone), encoded as AAC. Call before the first
   // write; then pass interleaved float samples (−1..1) in order.
@@ -49,7 +52,7 @@ class VideoEncoder {
 
   const std::string& codec_name() const;
   const std::string& pixel_format_name() const;
-  // Source streams carried (as source stream indices).
+  // Source streams carried (CarriedStream::index), in order.
   std::vector<int> carried_streams() const;
 
  private:

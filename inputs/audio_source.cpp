@@ -12,8 +12,8 @@ extern "C" {
 #include <libswresample/swresample.h>
 }
 
-#include "inputs/ffmpeg_input.hpp"
 #include "core/ffmpeg_raii.hpp"
+#include "inputs/ffmpeg_input.hpp"
 
 namespace nelf {
 
@@ -48,6 +48,7 @@ struct AudioSource::Impl {
     path = p;
     options = o;
     if (options.sample_rate <= 0) fail("the audio sample rate must be > 0");
+    if (options.channels <= 0) fail("the audio channel count must be > 0");
     // The same rule as VideoSource (DESIGN.md §11): no network unless asked for.
     network.allow_network = options.allow_network;
     const int opened = ffmpeg::open_input(format, path, network);
@@ -80,14 +81,16 @@ struct AudioSource::Impl {
     else if (av_channel_layout_copy(&in_layout, &f.ch_layout) < 0)
       fail("cannot read the audio channel layout");
     AVChannelLayout out_layout{};
-    av_channel_layout_default(&out_layout, 2);
+    av_channel_layout_default(&out_layout, options.channels);
     SwrContext* raw = nullptr;
     const int r = swr_alloc_set_opts2(&raw, &out_layout, AV_SAMPLE_FMT_FLT, options.sample_rate, &in_layout,
                                       static_cast<AVSampleFormat>(f.format), f.sample_rate, 0, nullptr);
     av_channel_layout_uninit(&in_layout);
     av_channel_layout_uninit(&out_layout);
     swr.reset(raw);
-    if (r < 0 || swr_init(swr.get()) < 0) fail("cannot convert the audio to stereo float");
+    if (r < 0 || swr_init(swr.get()) < 0)
+      fail(options.channels == 2 ? "cannot convert the audio to stereo float"
+                                 : fmt::format("cannot convert the audio to {}-channel float", options.channels));
   }
 
   std::optional<AudioChunk> convert(const AVFrame& f) {
@@ -102,8 +105,10 @@ struct AudioSource::Impl {
       pts = next_pts.value_or(0.0);
     const int capacity = swr_get_out_samples(swr.get(), f.nb_samples);
     if (capacity < 0) fail("cannot convert the audio");
+    const auto channels = static_cast<std::size_t>(options.channels);
     AudioChunk chunk;
-    chunk.samples.resize(static_cast<std::size_t>(capacity) * 2);
+    chunk.channels = options.channels;
+    chunk.samples.resize(static_cast<std::size_t>(capacity) * channels);
     auto* out = reinterpret_cast<std::uint8_t*>(chunk.samples.data());
     const int converted =
         swr_convert(swr.get(), &out, capacity, const_cast<const std::uint8_t**>(f.extended_data), f.nb_samples);
@@ -111,16 +116,16 @@ struct AudioSource::Impl {
       ++errors;
       return std::nullopt;
     }
-    chunk.samples.resize(static_cast<std::size_t>(converted) * 2);
+    chunk.samples.resize(static_cast<std::size_t>(converted) * channels);
     chunk.pts_s = pts;
     next_pts = pts + static_cast<double>(converted) / options.sample_rate;
     if (cut_before) {
       const double end = *next_pts;
-      if (end <= *cut_before) return AudioChunk{pts, {}};
+      if (end <= *cut_before) return AudioChunk{pts, {}, options.channels};
       if (pts < *cut_before) {
         const auto skip = static_cast<std::size_t>(std::lround((*cut_before - pts) * options.sample_rate));
         chunk.samples.erase(chunk.samples.begin(), chunk.samples.begin() + static_cast<std::ptrdiff_t>(std::min(
-                                                                               skip * 2, chunk.samples.size())));
+                                                                               skip * channels, chunk.samples.size())));
         chunk.pts_s = pts + static_cast<double>(skip) / options.sample_rate;
       }
       cut_before.reset();
@@ -204,7 +209,23 @@ AudioSource& AudioSource::operator=(AudioSource&&) noexcept = default;
 std::optional<AudioChunk> AudioSource::next() { return impl_->next(); }
 void AudioSource::seek(double seconds) { impl_->seek(seconds); }
 int AudioSource::sample_rate() const { return impl_->options.sample_rate; }
+int AudioSource::channels() const { return impl_->options.channels; }
 std::string AudioSource::codec_name() const { return impl_->codec->codec->name; }
 std::int64_t AudioSource::decode_errors() const { return impl_->errors; }
+
+OpenedAudio open_file_audio(const std::string& path, double origin_s, bool allow_network, AudioFormat format) {
+  AudioSourceOptions options;
+  options.origin_s = origin_s;
+  options.allow_network = allow_network;
+  if (format.sample_rate > 0) options.sample_rate = format.sample_rate;
+  if (format.channels > 0) options.channels = format.channels;
+  try {
+    return {std::make_unique<AudioSource>(path, options), {}};
+  } catch (const AudioError& e) {
+    return {nullptr, std::string(e.what()).find("no audio stream") != std::string::npos
+                         ? "no audio stream"
+                         : fmt::format("the audio cannot be decoded ({})", e.what())};
+  }
+}
 
 }  // namespace nelf

@@ -8,8 +8,11 @@
 #include <cstring>
 #include <utility>
 
-#include "inputs/synthetic_source.hpp"
 #include "core/user_error.hpp"
+#include "inputs/audio_source.hpp"
+#include "inputs/file_carried_streams.hpp"
+#include "inputs/synthetic_source.hpp"
+#include "inputs/synthetic_tone.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
 
@@ -63,12 +66,9 @@ class SyntheticFrameSource final : public StereoFrameSource {
     const int target = first_ + static_cast<int>(std::lround(std::max(0.0, seconds) * clip_.settings().fps));
     next_ = std::clamp(target, first_, clip_.frame_count());
   }
-  bool has_generated_audio() const override { return true; }
-  std::vector<float> generated_audio(std::int64_t first, int count) const override {
-    return clip_.audio(first + static_cast<std::int64_t>(first_) * clip_.settings().audio_rate / clip_.settings().fps,
-                       count);
+  OpenedAudio open_audio(AudioFormat format) const override {
+    return {open_synthetic_tone(clip_.settings(), first_, format), {}};
   }
-  int generated_audio_rate() const override { return clip_.settings().audio_rate; }
 
  private:
   SyntheticClip clip_;
@@ -78,7 +78,8 @@ class SyntheticFrameSource final : public StereoFrameSource {
 
 class FileFrameSource final : public StereoFrameSource {
  public:
-  FileFrameSource(const StereoSourceRequest& r) : path_(r.input), source_(open(r.input, r)) {
+  FileFrameSource(const StereoSourceRequest& r)
+      : path_(r.input), allow_network_(r.allow_network), source_(open(r.input, r)) {
     if (r.start_s) source_.seek(*r.start_s);
     pending_ = source_.next_frame();
     if (!pending_ && r.start_s && source_.info().duration_s && *r.start_s >= *source_.info().duration_s)
@@ -193,8 +194,12 @@ class FileFrameSource final : public StereoFrameSource {
     if (decision_.layout == StereoLayout::alt) *frames /= 2;
     return static_cast<long>(std::lround(*frames));
   }
-  std::string audio_path() const override { return path_; }
-  double origin_s() const override { return origin_s_; }
+  OpenedAudio open_audio(AudioFormat format) const override {
+    return open_file_audio(path_, origin_s_, allow_network_, format);
+  }
+  std::unique_ptr<CarriedStreams> open_carried_streams() const override {
+    return open_file_carried_streams(path_, origin_s_, allow_network_);
+  }
   std::optional<double> duration_s() const override {
     const auto& d = source_.info().duration_s;
     if (!d) return std::nullopt;
@@ -263,6 +268,7 @@ class FileFrameSource final : public StereoFrameSource {
   int height() const { return source_.info().height; }
 
   std::string path_;
+  bool allow_network_;  // for the audio and carried streams, opened on their own
   VideoSource source_;
   std::optional<VideoSource> right_;
   std::optional<VideoFrame> pending_;

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "core/audio_stream.hpp"
+#include "core/carried_streams.hpp"
 #include "core/frames.hpp"
 #include "core/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
@@ -42,10 +44,10 @@ class StereoFrameSource {
   virtual std::optional<StereoVideoFrame> next() = 0;
   virtual double frame_rate() const = 0;
   virtual std::optional<long> expected_frames() const = 0;
-  // Input duration in seconds from origin_s() when known.
+  // Input duration in seconds from pts_s 0 when known.
   virtual std::optional<double> duration_s() const = 0;
   // Positions the source so that next() returns the frames at or after `seconds` (on the pts_s
-  // timeline, i.e. from origin_s()). Throws UserError when the input cannot seek.
+  // timeline). Throws UserError when the input cannot seek.
   virtual void seek(double seconds) = 0;
   // From the next frame on (seeks included), deliver the views block-averaged as `choose` says for
   // this input's view size, when the input allows it (one block for both views, a stream swscale
@@ -53,16 +55,16 @@ class StereoFrameSource {
   // whole views. Returns the block the next frames carry. The synthetic source and pair inputs
   // always deliver whole views.
   virtual std::array<int, 2> reduce_views(const ViewBlockChooser& /*choose*/) { return {1, 1}; }
-  // The container whose audio/subtitles go with the video (opened separately), if any.
-  virtual std::string audio_path() const { return {}; }
-  virtual bool has_generated_audio() const { return false; }
-  // Mono samples [first, first + count) of generated audio, counted from pts_s 0.
-  virtual std::vector<float> generated_audio(std::int64_t /*first*/, int /*count*/) const { return {}; }
-  virtual int generated_audio_rate() const { return 0; }
+  // The sound that goes with the video, decoded as `format` asks, on the pts_s timeline (from the
+  // start or the requested start): a file's audio, the synthetic clip's tone; or why there is none,
+  // in words ("no audio stream", "the audio cannot be decoded (…)"). Each call opens a new stream.
+  virtual OpenedAudio open_audio(AudioFormat /*format*/) const { return {nullptr, "no audio stream"}; }
+  // The encoded streams a file output copies as they are (a file's audio, subtitles, chapters and
+  // metadata), on the pts_s timeline; null when the input has none to copy (the synthetic clip:
+  // its sound is open_audio()'s to encode). Throws UserError when they cannot be opened.
+  virtual std::unique_ptr<CarriedStreams> open_carried_streams() const { return nullptr; }
   // Frames lost or damaged so far (decode errors, read errors, frames promised but missing).
   virtual std::int64_t lost_frames() const { return 0; }
-  // Source time (s, on the container's clock) that becomes pts_s 0.
-  virtual double origin_s() const { return 0.0; }
 };
 
 // Opens the input (and --right), detects the layout from the first frame and prints one line

@@ -4,20 +4,21 @@
 #include <chrono>
 #include <condition_variable>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
 #include <utility>
 
+#include "core/audio_stream.hpp"
 #include "hmz_output/audio_output.hpp"
-#include "inputs/audio_source.hpp"
 
 namespace nelf::playback {
 
 // Feeds decoded audio to the device, about half a second ahead, until stopped.
 class AudioFeeder {
  public:
-  AudioFeeder(AudioSource source, AudioOutput& output) : source_(std::move(source)), output_(output) {
+  AudioFeeder(std::unique_ptr<AudioStream> source, AudioOutput& output) : source_(std::move(source)), output_(output) {
     thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
   }
   ~AudioFeeder() {
@@ -46,7 +47,7 @@ class AudioFeeder {
         std::unique_lock lock(mutex_);
         if (seek_to_) {
           try {
-            source_.seek(*std::exchange(seek_to_, std::nullopt));
+            source_->seek(*std::exchange(seek_to_, std::nullopt));
           } catch (const AudioError&) {
             ended_ = true;  // a file that cannot seek its audio plays on without it
             output_.end_of_stream();
@@ -64,11 +65,11 @@ class AudioFeeder {
       }
       std::optional<AudioChunk> chunk;
       try {
-        chunk = source_.next();
+        chunk = source_->next();
       } catch (const AudioError&) {
         chunk.reset();  // the audio is beyond repair: the video goes on, on the clock the sound left
       }
-      errors_.store(source_.decode_errors());
+      errors_.store(source_->decode_errors());
       std::lock_guard lock(mutex_);
       if (generation != generation_) continue;  // decoded before a seek
       if (!chunk) {
@@ -80,7 +81,7 @@ class AudioFeeder {
     }
   }
 
-  AudioSource source_;
+  std::unique_ptr<AudioStream> source_;
   AudioOutput& output_;
   std::mutex mutex_;
   std::condition_variable_any wake_;

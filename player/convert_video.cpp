@@ -29,7 +29,6 @@ extern "C" {
 #include "hmz_output/frame_sink.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
-#include "inputs/ffmpeg_input.hpp"
 #include "inputs/stereo_frame_source.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
@@ -41,118 +40,83 @@ namespace nelf {
 
 namespace {
 
-// Carries the source's audio and subtitles: a second demuxer on the same file, read in step with
-// the video so the muxer's interleaving buffer stays small.
-class SourcePacketCarrier {
- public:
-  SourcePacketCarrier(const std::string& path, double origin_s, bool allow_network) : origin_s_(origin_s) {
-    network_.allow_network = allow_network;
-    const int opened = ffmpeg::open_input(format_, path, network_);
-    if (const auto stopped = ffmpeg::guard_stop(path, network_)) throw UserError(*stopped, 1);
-    if (opened < 0)
-      throw UserError(fmt::format("{}: cannot reopen for audio: {}", path, ffmpeg::error_string(opened)), 1);
-    const int found = ffmpeg::find_stream_info(format_.get(), network_);
-    if (const auto stopped = ffmpeg::guard_stop(path, network_)) throw UserError(*stopped, 1);
-    if (found < 0) throw UserError(fmt::format("{}: cannot read stream information", path), 1);
-    if (origin_s > format_->start_time / static_cast<double>(AV_TIME_BASE) + 0.001)
-      av_seek_frame(format_.get(), -1, static_cast<std::int64_t>(origin_s * AV_TIME_BASE), AVSEEK_FLAG_BACKWARD);
-  }
-  AVFormatContext* format() const { return format_.get(); }
-
-  // Writes the carried packets up to output time `until_s` (all of them when nullopt, up to `end_s`).
-  void carry_until(VideoEncoder& encoder, std::optional<double> until_s, std::optional<double> end_s) {
-    const auto carried = encoder.carried_streams();
-    if (carried.empty() || done_) return;
-    for (;;) {
-      if (!packet_) {
-        packet_.reset(av_packet_alloc());
-        if (av_read_frame(format_.get(), packet_.get()) < 0) {
-          done_ = true;
-          packet_.reset();
-          return;
-        }
-      }
-      const AVStream* stream = format_->streams[packet_->stream_index];
-      const std::int64_t ts = packet_->pts != AV_NOPTS_VALUE ? packet_->pts : packet_->dts;
-      const double t = ts == AV_NOPTS_VALUE ? 0.0 : ts * av_q2d(stream->time_base) - origin_s_;
-      const bool wanted = std::find(carried.begin(), carried.end(), packet_->stream_index) != carried.end();
-      // Only a carried packet waits for later: in MPEG-TS the audio lies behind the video in the
-      // file (the muxer gathers several audio frames per PES packet), so stopping at a video
-      // packet would leave out audio that belongs before it.
-      if (wanted && until_s && t > *until_s) return;  // keep it for later
-      if (wanted && t >= -1e-6 && (!end_s || t < *end_s)) {
-        // Shift to output time (the conversion starts at 0).
-        const std::int64_t shift = llround(origin_s_ / av_q2d(stream->time_base));
-        if (packet_->pts != AV_NOPTS_VALUE) packet_->pts -= shift;
-        if (packet_->dts != AV_NOPTS_VALUE) packet_->dts -= shift;
-        encoder.write_source_packet(packet_.get(), packet_->stream_index);
-      }
-      packet_.reset();
-    }
-  }
-
- private:
-  ffmpeg::InputGuard network_;  // before `format_`: the context points at it while it lives
-  ffmpeg::FormatContextPtr format_;
-  ffmpeg::PacketPtr packet_;
-  double origin_s_;
-  bool done_ = false;
-};
-
+// An encoded video file, with the source's own streams copied when it has them (a file's audio,
+// subtitles and chapters), else its decoded sound (the synthetic clip's tone) encoded.
 class EncodedFileSink final : public FrameSink {
  public:
-  EncodedFileSink(const VideoConvertRequest& r, StereoFrameSource& source, int width, int height, int bits,
-                  double origin_s)
-      : source_(source), output_(r.output) {
-    if (!source.audio_path().empty() && r.encoder.audio)
-      carrier_.emplace(source.audio_path(), origin_s, r.allow_network);
+  EncodedFileSink(const VideoConvertRequest& r, std::unique_ptr<CarriedStreams> carried,
+                  std::unique_ptr<AudioStream> audio, int width, int height, int bits, double frame_rate)
+      : output_(r.output), frame_rate_(frame_rate), carried_(std::move(carried)), audio_(std::move(audio)) {
     EncoderSettings settings = r.encoder;
     settings.bits = bits;
-    const AVRational rate = av_d2q(source.frame_rate(), 100000);
+    const AVRational rate = av_d2q(frame_rate, 100000);
     try {
-      encoder_.emplace(r.output, width, height, rate.num, rate.den, settings, carrier_ ? carrier_->format() : nullptr);
+      encoder_.emplace(r.output, width, height, rate.num, rate.den, settings, carried_ ? &carried_->layout() : nullptr);
     } catch (const std::invalid_argument& e) {
       throw UserError(e.what(), 2);
     } catch (const std::runtime_error& e) {
       throw UserError(e.what(), 1);
     }
-    if (source.has_generated_audio() && r.encoder.audio) {
-      encoder_->add_audio_track(source.generated_audio_rate(), 1);
-      generated_rate_ = source.generated_audio_rate();
-    }
+    if (audio_) encoder_->add_audio_track(audio_->sample_rate(), audio_->channels());
+    if (carried_) carried_indices_ = encoder_->carried_streams();
     end_s_ = r.duration_s;
   }
   void write(const PackedFrame& frame) override {
     encoder_->write_video(frame);
-    last_end_s_ = frame.pts_seconds + 1.0 / source_.frame_rate();
+    last_end_s_ = frame.pts_seconds + 1.0 / frame_rate_;
     // Only what starts before this frame ends: the conversion may stop at any frame (--frames, a
     // damaged input), and audio already written past that point could not be taken back.
-    if (carrier_) carrier_->carry_until(*encoder_, last_end_s_ - 1e-6, end_s_);
-    if (generated_rate_ > 0) {
-      const auto until = static_cast<std::int64_t>(std::llround(last_end_s_ * generated_rate_));
-      if (until > audio_written_) {
-        const auto samples = source_.generated_audio(audio_written_, static_cast<int>(until - audio_written_));
-        encoder_->write_audio(samples.data(), static_cast<int>(samples.size()));
-        audio_written_ = until;
-      }
-    }
+    carry_until(last_end_s_ - 1e-6, end_s_);
+    if (audio_) encode_audio_until(std::llround(last_end_s_ * audio_->sample_rate()));
   }
   void finish() override {
     // Audio ends with the video (what was converted), not with the source.
-    if (carrier_) carrier_->carry_until(*encoder_, last_end_s_, last_end_s_);
+    carry_until(last_end_s_, last_end_s_);
     encoder_->finish();
   }
   std::string description() const override { return output_; }
 
  private:
-  StereoFrameSource& source_;
+  // The carried packets up to output time `until_s`, before `end_s`.
+  void carry_until(std::optional<double> until_s, std::optional<double> end_s) {
+    if (!carried_) return;
+    while (auto packet = carried_->next_packet(carried_indices_, until_s, end_s))
+      encoder_->write_source_packet(packet.get(), packet->stream_index);
+  }
+  // The decoded sound up to its first `until` sample frames in all (a stream that ends early ends
+  // the track there). It follows on from 0 as the chunks come; their own times are not read.
+  void encode_audio_until(std::int64_t until) {
+    while (audio_written_ < until) {
+      if (pending_offset_ >= pending_.frames()) {
+        std::optional<AudioChunk> chunk;
+        try {
+          chunk = audio_->next();
+        } catch (const AudioError& e) {
+          throw UserError(e.what(), 1);
+        }
+        if (!chunk) return;
+        pending_ = std::move(*chunk);
+        pending_offset_ = 0;
+        continue;
+      }
+      const std::int64_t count = std::min(until - audio_written_, pending_.frames() - pending_offset_);
+      encoder_->write_audio(pending_.samples.data() + pending_offset_ * pending_.channels, static_cast<int>(count));
+      pending_offset_ += count;
+      audio_written_ += count;
+    }
+  }
+
   std::string output_;
-  std::optional<SourcePacketCarrier> carrier_;
+  double frame_rate_;
+  std::unique_ptr<CarriedStreams> carried_;
+  std::vector<int> carried_indices_;  // what the encoder carries of carried_
+  std::unique_ptr<AudioStream> audio_;
+  AudioChunk pending_;  // decoded and not all encoded yet, from pending_offset_ on
+  std::int64_t pending_offset_ = 0;
   std::optional<VideoEncoder> encoder_;
   std::optional<double> end_s_;
   double last_end_s_ = 0.0;
-  int generated_rate_ = 0;
-  std::int64_t audio_written_ = 0;
+  std::int64_t audio_written_ = 0;  // sample frames
 };
 
 // frames_%05d.png: one image per frame. Written files are removed again unless finish() is reached.
@@ -427,7 +391,14 @@ constexpr FrameSinkDriver kFrameSinks[] = {
      }},
     {"encoded", [](const std::string&) { return true; },
      [](const FrameSinkContext& c) -> std::unique_ptr<FrameSink> {
-       return std::make_unique<EncodedFileSink>(c.request, c.source, c.width, c.height, c.bits, c.source.origin_s());
+       std::unique_ptr<CarriedStreams> carried;
+       std::unique_ptr<AudioStream> audio;
+       if (c.request.encoder.audio) {
+         carried = c.source.open_carried_streams();
+         if (!carried) audio = c.source.open_audio({}).stream;
+       }
+       return std::make_unique<EncodedFileSink>(c.request, std::move(carried), std::move(audio), c.width, c.height,
+                                                c.bits, c.source.frame_rate());
      }},
 };
 

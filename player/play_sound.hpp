@@ -1,6 +1,7 @@
 #pragma once
-// The sound of `nelf play` and the master clock it gives: the file's audio decoded and fed to the
-// device, whose clock then paces the pictures; else the system clock, with the reason in words.
+// The sound of `nelf play` and the master clock it gives: the source's audio (a file's, the
+// synthetic clip's tone) fed to the device, whose clock then paces the pictures; else the system
+// clock, with the reason in words.
 #include <memory>
 #include <string>
 

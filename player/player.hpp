@@ -24,8 +24,7 @@ struct PlayerOptions {
   Profile profile;
   Signal signal;
   CompositorOptions compositor;
-  bool audio = true;           // false: --no-audio
-  bool allow_network = false;  // for reopening the input's audio
+  bool audio = true;  // false: --no-audio
   int audio_rate = 48000;
   std::string log_frames;  // CSV of every refresh (diagnostics); "" = none
   bool quiet = false;      // no "playing …" / audio status lines on stderr (warnings still are)

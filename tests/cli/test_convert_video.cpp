@@ -366,6 +366,46 @@ TEST(ConvertVideo, SyntheticClipWithAudio) {
   EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"out.mkv", "small.toml"}));
 }
 
+// The packets of `stream` in `path` (pts and size, one a line) as ffprobe lists them.
+std::string packet_list(const std::filesystem::path& path, const std::string& stream) {
+  const auto r = run_command("ffprobe -v error -select_streams " + stream +
+                             " -show_entries packet=pts,size -of csv=p=0 " + q(path));
+  EXPECT_EQ(r.status, 0) << r.err;
+  return r.out;
+}
+
+// The input's audio, subtitles, chapters and title go into the output as they are: the same
+// streams with their tags, and the same packets.
+TEST(ConvertVideo, CarriesTheInputsAudioSubtitlesAndChaptersAsTheyAre) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  write_file(dir / "subs.srt", "1\n00:00:00,000 --> 00:00:00,400\nhello\n\n2\n00:00:00,500 --> 00:00:00,900\nbye\n");
+  write_file(dir / "meta.txt", ";FFMETADATA1\ntitle=Clip\n[CHAPTER]\nTIMEBASE=1/1000\nSTART=0\nEND=500\ntitle=One\n");
+  make_media(dir / "clip.mkv",
+             "-f lavfi -i color=c=red:s=320x180:r=24:d=1 -f lavfi -i color=c=blue:s=320x180:r=24:d=1 -f lavfi -i "
+             "sine=frequency=440:sample_rate=48000:duration=1 -i " +
+                 q(dir / "subs.srt") + " -i " + q(dir / "meta.txt") +
+                 " -filter_complex [0][1]hstack[v] -map [v] -map 2:a -map 3:s -map_metadata 4 -map_chapters 4 "
+                 "-c:a flac -c:s srt -metadata:s:a:0 language=fra" +
+                 h264);
+  const auto r = run_nelf("convert " + q(dir / "clip.mkv") + " " + q(dir / "out.mkv") +
+                          " --signal sbs --quiet --profile " + q(profile));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto streams = run_command(
+      "ffprobe -v error -show_entries stream=codec_type,codec_name:stream_tags=language:format_tags=title "
+      "-show_chapters -of csv=p=0 " +
+      q(dir / "out.mkv"));
+  EXPECT_NE(streams.out.find("h264,video"), std::string::npos) << streams.out;
+  EXPECT_NE(streams.out.find("flac,audio,fra"), std::string::npos) << streams.out;
+  EXPECT_NE(streams.out.find("subrip,subtitle"), std::string::npos) << streams.out;
+  EXPECT_NE(streams.out.find(",One"), std::string::npos) << streams.out;
+  EXPECT_NE(streams.out.find("Clip"), std::string::npos) << streams.out;
+  const std::string audio = packet_list(dir / "clip.mkv", "a:0"), subtitles = packet_list(dir / "clip.mkv", "s:0");
+  EXPECT_GT(std::count(audio.begin(), audio.end(), '\n'), 5) << audio;
+  EXPECT_EQ(packet_list(dir / "out.mkv", "a:0"), audio);
+  EXPECT_EQ(packet_list(dir / "out.mkv", "s:0"), subtitles);
+}
+
 // ---------------------------------------------------------------------------------------------
 
 TEST(ConvertVideo, BadInputs) {

@@ -166,6 +166,22 @@ TEST_F(PlayCli, AFileWithoutSoundPlaysOnTheSystemClock) {
   EXPECT_NE(r.err.find("nelf: no audio stream: playing without sound\n"), std::string::npos) << r.err;
 }
 
+// The synthetic clip's tone is its sound, played and pacing the video as a file's audio does.
+TEST_F(PlayCli, TheSyntheticClipPlaysItsTone) {
+  const auto log = dir_ / "frames.csv";
+  const auto r = run_command(env() + NELF_BINARY + " play synthetic:duration=1,size=160x90 --profile " +
+                             q(small_profile(dir_)) + " --log-frames " + q(log));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("nelf: sound: dummy, 48000 Hz"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("playing without sound"), std::string::npos) << r.err;
+  const auto rows = read_log(log);
+  ASSERT_FALSE(rows.empty());
+  for (const auto& row : rows) {
+    if (row.event != "shown") continue;
+    EXPECT_FALSE(row.audio_clock.empty()) << "no audio clock with sound";
+  }
+}
+
 TEST_F(PlayCli, InterruptExitsWith130AndTheSummary) {
   const auto clip = make_clip(dir_, "long.mp4", 20, 24, false);
   const auto r =

@@ -166,7 +166,8 @@ TEST(VideoEncoder, CarriesAudioSubtitlesAndChapters) {
   ASSERT_GE(avformat_find_stream_info(source.get(), nullptr), 0);
 
   const auto out = dir / "out.mkv";
-  VideoEncoder enc(out, 64, 36, 10, 1, EncoderSettings{}, source.get());
+  const CarriedStreamLayout carried = describe_carried_streams(*source);
+  VideoEncoder enc(out, 64, 36, 10, 1, EncoderSettings{}, &carried);
   EXPECT_EQ(enc.carried_streams(), (std::vector<int>{1, 2}));
   AVPacket* packet = av_packet_alloc();
   int frame_index = 0;
@@ -236,7 +237,8 @@ TEST(VideoEncoder, ReencodesAudioTheContainerCannotHold) {
   std::unique_ptr<AVFormatContext, InputCloser> source(raw);
   ASSERT_GE(avformat_find_stream_info(source.get(), nullptr), 0);
   const auto out = dir / "out.mp4";
-  VideoEncoder enc(out, 64, 36, 10, 1, EncoderSettings{}, source.get());
+  const CarriedStreamLayout carried = describe_carried_streams(*source);
+  VideoEncoder enc(out, 64, 36, 10, 1, EncoderSettings{}, &carried);
   AVPacket* packet = av_packet_alloc();
   int frame_index = 0;
   while (av_read_frame(source.get(), packet) >= 0) {
