@@ -12,7 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include "app/commands.hpp"
-#include "compositor/make_compositor.hpp"
+#include "compositor/frame_compositor.hpp"
 #include "core/printable.hpp"
 #include "hmz_output/frame_sink.hpp"
 #include "hmz_output/image_sink.hpp"
@@ -100,8 +100,7 @@ void refuse_options_raw_cannot_apply(const ConvertArgs& args) {
 
 // A still to `-`: its one packed frame, as the raw sink writes a video's.
 void write_packed_still_raw(const StereoPair& views, const ConvertPlan& plan) {
-  const auto compositor = make_compositor(plan.profile, plan.compositor);
-  const Image packed = pack_eyes(plan.signal, compositor->compose(views));
+  const Image packed = packed_still(views, plan.profile, plan.signal, plan.compositor);
   PackedFrame frame{packed.width(), packed.height(), 8, {}, 0.0};
   frame.rgba.resize(static_cast<std::size_t>(packed.width()) * packed.height() * 4);
   const float* in = packed.data();
@@ -212,11 +211,15 @@ Signal resolve_signal(const Profile& profile, const std::string& name) {
   return *signal;
 }
 
+Image packed_still(const StereoPair& views, const Profile& profile, const Signal& signal,
+                   const CompositorOptions& options) {
+  FrameCompositor compositor(profile, options, packed_layout(signal, profile.display.resolution));
+  return compositor.render_still(views);
+}
+
 void write_packed_still(const StereoPair& views, const Profile& profile, const Signal& signal,
                         const CompositorOptions& options, const std::string& output, const ImageWriteOptions& write) {
-  const auto compositor = make_compositor(profile, options);
-  const EyeImages eyes = compositor->compose(views);
-  const Image frame = pack_eyes(signal, eyes);
+  const Image frame = packed_still(views, profile, signal, options);
   try {
     write_image_file(frame, output, write);
   } catch (const ImageWriteError& e) {

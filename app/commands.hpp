@@ -7,12 +7,12 @@
 #include <string>
 
 #include "compositor/compositor.hpp"
-#include "optics/profile.hpp"
+#include "core/pixel_limit.hpp"
+#include "core/user_error.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/signal.hpp"
-#include "core/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
-#include "core/user_error.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf::app {
 
@@ -60,9 +60,12 @@ void refuse_gpu_for_live_output(const std::optional<int>& gpu, const std::string
 // Throws UserError (status 2) naming the signals there are.
 Signal resolve_signal(const Profile& profile, const std::string& name);
 
-// The stills path of convert (also calibrate --pattern): composes `views` with the GL compositor,
-// packs both eyes into `signal`'s frame and writes it to `output` (nothing half-written). Throws
-// UserError (status 1) when the file cannot be written.
+// The packed frame of a still (convert, calibrate --pattern): both eyes of `views` composited and
+// placed in `signal`'s frame by the compositor facade (FrameCompositor::render_still).
+Image packed_still(const StereoPair& views, const Profile& profile, const Signal& signal,
+                   const CompositorOptions& options);
+// packed_still() written to `output` (nothing half-written). Throws UserError (status 1) when the
+// file cannot be written.
 void write_packed_still(const StereoPair& views, const Profile& profile, const Signal& signal,
                         const CompositorOptions& options, const std::string& output, const ImageWriteOptions& write);
 

@@ -4,7 +4,11 @@
 // into the frame (the GL compositor's targets, the CPU composite tables, pack_eyes).
 #include <array>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <utility>
+
+#include "core/image.hpp"
 
 namespace nelf {
 
@@ -21,5 +25,15 @@ struct PackedLayout {
   std::array<std::optional<EyeArea>, 2> areas;
   std::array<std::optional<std::pair<int, int>>, 2> origins;
 };
+
+// Video renders an eye only where it fits its area (GL draws the whole panel at its origin): throws
+// UserError (status 2) "the WxH panel of profile P does not fit the WxH eye area of signal S",
+// followed by `advice`, when an eye image is larger than the area the signal reserves for it.
+void require_eyes_fit(const PackedLayout& layout, std::string_view profile_name, std::string_view signal_name,
+                      std::string_view advice = {});
+
+// The packed frame of `layout` holding `eyes` (each layout.eye in size, else std::invalid_argument):
+// each eye image at its origin, clipped to its area, black (alpha 1) elsewhere. What stills are.
+Image place_eyes(const PackedLayout& layout, const EyeImages& eyes);
 
 }  // namespace nelf

@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -10,8 +12,7 @@
 #include <thread>
 #include <utility>
 
-#include "compositor/gl/gl_compositor.hpp"
-#include "compositor/overlays/text_overlay.hpp"
+#include "compositor/frame_compositor.hpp"
 #include "core/printable.hpp"
 #include "core/user_error.hpp"
 #include "hmz_output/image_sink.hpp"
@@ -35,27 +36,28 @@ std::unique_ptr<Display> open_display(const CalibrateSession& s) {
   return open_live_display({s.output, s.monitor, s.connector, "nelf calibrate (h: help)", s.gpu}, s.profile, s.signal);
 }
 
-// The pattern's views on the GPU, rebuilt when the pattern or its geometry changes.
-struct PatternTextures {
-  gl::Texture left, right;
-  int width = 0, height = 0;
-  double aspect = 0.0;
-
-  void upload(TestPattern pattern, const PatternGeometry& geometry) {
-    StereoPair views;
-    try {
-      views = make_test_pattern(pattern, geometry);
-    } catch (const TestPatternError& e) {
-      throw UserError(fmt::format("pattern {}: {}", test_pattern_name(pattern), e.what()), 2);
-    }
-    left = upload_texture(views.left.image, GL_RGBA8);
-    right = upload_texture(views.right.image, GL_RGBA8);
-    width = views.left.image.width();
-    height = views.left.image.height();
-    aspect = views.left.aspect();
+// The pattern's views as an 8-bit frame (what the GL compositor samples them as), made again
+// when the pattern or its geometry changes.
+std::shared_ptr<const StereoVideoFrame> pattern_frame(TestPattern pattern, const PatternGeometry& geometry) {
+  StereoPair views;
+  try {
+    views = make_test_pattern(pattern, geometry);
+  } catch (const TestPatternError& e) {
+    throw UserError(fmt::format("pattern {}: {}", test_pattern_name(pattern), e.what()), 2);
   }
-  GlTextureView view(Eye eye) const { return {(eye == Eye::left ? left : right).id(), width, height, aspect}; }
-};
+  auto frame = std::make_shared<StereoVideoFrame>();
+  frame->width = views.left.image.width();
+  frame->height = views.left.image.height();
+  frame->aspect = views.left.aspect();
+  for (auto [image, bytes] :
+       {std::pair{&views.left.image, &frame->left}, std::pair{&views.right.image, &frame->right}}) {
+    const float* in = image->data();
+    bytes->resize(static_cast<std::size_t>(image->width()) * image->height() * 4);
+    for (std::size_t i = 0; i < bytes->size(); ++i)
+      (*bytes)[i] = static_cast<std::uint8_t>(std::lround(std::clamp(in[i], 0.f, 1.f) * 255.f));
+  }
+  return frame;
+}
 
 class Session {
  public:
@@ -63,7 +65,8 @@ class Session {
       : settings_(s),
         display_(open_display(s)),
         controls_(s.profile, s.pattern, 16.0 / 9.0),
-        compositor_(std::make_unique<GlCompositor>(s.profile, s.compositor, display_->context())) {
+        compositor_(s.profile, s.compositor, packed_layout(s.signal, s.profile.display.resolution),
+                    display_->context()) {
     upload_pattern();
   }
 
@@ -114,12 +117,12 @@ class Session {
       if (profile_changed) {
         // The mapping follows the profile: a new compositor (its programs come from Mesa's shader
         // cache or the driver's), and the pattern drawn again where its geometry changed.
-        compositor_ = std::make_unique<GlCompositor>(controls_.profile(), settings_.compositor, display_->context());
+        compositor_.set_profile(controls_.profile());
       }
       if (profile_changed || pattern_changed) upload_pattern();
       const auto now = std::chrono::steady_clock::now();
-      if (!overlay_.text().empty() && now >= message_until_) {
-        overlay_.set_text("");
+      if (!message_.empty() && now >= message_until_) {
+        message_.clear();
         dirty = true;
       }
       const bool rendered = dirty;
@@ -162,12 +165,12 @@ class Session {
   void upload_pattern() {
     const PatternGeometry geometry = pattern_geometry(controls_.profile());
     if (uploaded_ && geometry == uploaded_->first && controls_.pattern() == uploaded_->second) return;
-    patterns_.upload(controls_.pattern(), geometry);
+    pattern_ = pattern_frame(controls_.pattern(), geometry);
     uploaded_ = {geometry, controls_.pattern()};
   }
 
   void show(const std::string& message) {
-    overlay_.set_text(message);
+    message_ = message;
     message_until_ = std::chrono::steady_clock::now() + kMessageTime;
   }
 
@@ -181,24 +184,17 @@ class Session {
 
   void render() {
     display_->context()->make_current();
-    const GLuint fbo = display_->packed_framebuffer();
-    const GLfloat black[4] = {0.f, 0.f, 0.f, 1.f};
-    glClearNamedFramebufferfv(fbo, GL_COLOR, 0, black);
-    const PackedLayout layout = packed_layout(settings_.signal, controls_.profile().display.resolution);
-    for (Eye eye : {Eye::left, Eye::right}) {
-      const auto& origin = layout.origins[static_cast<int>(eye)];
-      if (!origin) continue;
-      compositor_->render_eye(eye, overlay_.apply(eye, patterns_.view(eye)),
-                              GlTarget{fbo, origin->first, origin->second});
-    }
+    compositor_.render(
+        pattern_, {message_, false, false},
+        PackedTarget::gl(display_->packed_framebuffer(), display_->packed_texture(), display_->packed_size()));
   }
 
   const CalibrateSession& settings_;
   std::unique_ptr<Display> display_;
   CalibrationControls controls_;
-  std::unique_ptr<GlCompositor> compositor_;
-  TextOverlay overlay_;
-  PatternTextures patterns_;
+  FrameCompositor compositor_;
+  std::shared_ptr<const StereoVideoFrame> pattern_;
+  std::string message_;
   std::optional<std::pair<PatternGeometry, TestPattern>> uploaded_;
   std::chrono::steady_clock::time_point message_until_;
   std::size_t help_line_ = 0;

@@ -20,11 +20,10 @@ extern "C" {
 #include <unistd.h>
 }
 
-#include "compositor/cpu/composite_table_cache.hpp"
+#include "compositor/frame_compositor.hpp"
 #include "compositor/gl/gl_compositor.hpp"
 #include "core/bounded_queue.hpp"
 #include "core/ffmpeg_raii.hpp"
-#include "core/gl/egl_context.hpp"
 #include "core/user_error.hpp"
 #include "hmz_output/frame_sink.hpp"
 #include "hmz_output/image_sink.hpp"
@@ -210,142 +209,6 @@ class BufferPool {
   std::vector<std::vector<std::uint8_t>> free_;
 };
 
-// The compositing stage: both eyes of each frame into a packed frame for the encoder, from CPU
-// composite tables on software GL (see below), else with GL (upload the views, render straight
-// into the packed frame, read it back).
-class PackedFrameRenderer {
- public:
-  PackedFrameRenderer(const VideoConvertRequest& r, int view_w, int view_h, int bits, double aspect,
-                      std::array<int, 2> block)
-      : signal_(r.signal), view_w_(view_w), view_h_(view_h), bits_(bits), block_(block) {
-    validate_fsaa(r.compositor.fsaa);
-    const auto panel = panel_ = r.profile.display.resolution;
-    const PackedLayout layout = packed_layout(signal_, panel);
-    width_ = layout.packed[0];
-    height_ = layout.packed[1];
-    for (const auto& area : layout.areas)
-      if (area && (panel[0] > area->width || panel[1] > area->height))
-        throw UserError(fmt::format("the {}x{} panel of profile {} does not fit the {}x{} eye area of signal {}; "
-                                    "use --signal sbs, tab, left or right",
-                                    panel[0], panel[1], r.profile.name, area->width, area->height, signal_.name),
-                        2);
-    origins_ = layout.origins;
-    // On a software rasteriser 8-bit block means are composited on the CPU from tables recorded
-    // once with the compositor's shaders (compositor/cpu/composite_table.hpp): several times cheaper
-    // than llvmpipe's passes. Tables seen before come from the cache without starting GL at all.
-    const CompositeTableCache cache;
-    if (bits == 8 && tables_from_cache(r, cache, aspect)) return;
-    compositor_.emplace(r.profile, r.compositor,
-                        std::make_shared<gl::EglContext>(gl::ContextOptions{r.compositor.gpu}));
-    if (bits == 8 && prefer_composite_table(compositor_->context())) load_tables(r, cache, &*compositor_, aspect);
-    if (tables_[0] || tables_[1]) return;
-    const GLenum internal = bits > 8 ? GL_RGBA16 : GL_RGBA8;
-    for (auto& t : views_) t = gl::make_texture_2d(internal, texture_w(), texture_h());
-    packed_ = gl::make_texture_2d(internal, width_, height_);
-    packed_fbo_ = gl::make_framebuffer(packed_);
-  }
-  int width() const { return width_; }
-  int height() const { return height_; }
-
-  PackedFrame render(const StereoVideoFrame& f, BufferPool& buffers) {
-    if (tables_[0] || tables_[1]) return render_from_tables(f, buffers);
-    const GLenum type = bits_ > 8 ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE;
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage2D(views_[0].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, f.left.data());
-    glTextureSubImage2D(views_[1].id(), 0, 0, 0, texture_w(), texture_h(), GL_RGBA, type, f.right.data());
-    const float black[4] = {0.f, 0.f, 0.f, 1.f};
-    glClearNamedFramebufferfv(packed_fbo_.id(), GL_COLOR, 0, black);
-    for (Eye eye : {Eye::left, Eye::right}) {
-      const auto& origin = origins_[static_cast<int>(eye)];
-      if (!origin) continue;
-      const GlTextureView view{views_[static_cast<int>(eye)].id(), view_w_, view_h_, f.aspect};
-      const GlTarget target{packed_fbo_.id(), origin->first, origin->second};
-      if (block_[0] > 1 || block_[1] > 1)
-        compositor_->render_eye_reduced(eye, GlReducedView{view, block_}, target);
-      else
-        compositor_->render_eye(eye, view, target);
-    }
-    PackedFrame out{width_, height_, bits_ > 8 ? 16 : 8,
-                    buffers.take(static_cast<std::size_t>(width_) * height_ * bytes_per_pixel(bits_)), f.pts_s};
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, packed_fbo_.id());
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, width_, height_, GL_RGBA, type, out.rgba.data());
-    gl::check_error("reading back the packed frame");
-    return out;
-  }
-
- private:
-  // Both eyes' tables from `cache`, where the CPU path is wanted without asking GL: never on a
-  // machine that may have a GPU (a render node), unless NELF_COMPOSITE=table says so.
-  bool tables_from_cache(const VideoConvertRequest& r, const CompositeTableCache& cache, double aspect) {
-    const CompositeChoice choice = composite_choice();
-    if (choice == CompositeChoice::gl || (choice == CompositeChoice::automatic && has_render_node())) return false;
-    // GL would have refused a --gpu (or NELF_GPU) that names no device: so does a cache hit.
-    gl::check_requested_gpu(gl::ContextOptions{r.compositor.gpu});
-    return load_tables(r, cache, nullptr, aspect);
-  }
-  // Both eyes' tables from `cache`, else recorded with `recorder` (when given, and kept in
-  // `cache`); none when an eye has no table (fsaa other than 1, whole views).
-  bool load_tables(const VideoConvertRequest& r, const CompositeTableCache& cache, GlCompositor* recorder,
-                   double aspect) {
-    for (Eye eye : {Eye::left, Eye::right}) {
-      if (!origins_[static_cast<int>(eye)]) continue;
-      tables_[static_cast<int>(eye)] = load_or_record_composite_table(cache, recorder, r.profile, r.compositor, eye,
-                                                                      view_w_, view_h_, aspect, block_);
-      if (!tables_[static_cast<int>(eye)]) {
-        tables_ = {};
-        return false;
-      }
-    }
-    return tables_[0] || tables_[1];
-  }
-
-  // The CPU path: both eyes from their tables straight into the packed frame, black around them.
-  PackedFrame render_from_tables(const StereoVideoFrame& f, BufferPool& buffers) {
-    PackedFrame out{width_, height_, 8, buffers.take(static_cast<std::size_t>(width_) * height_ * 4), f.pts_s};
-    fill_outside_eyes(out.rgba.data());
-    // While x264 fills its look-ahead the compositing is what the pipeline waits for: the eyes
-    // render in parallel.
-    render_packed_eyes(tables_, {f.left.data(), f.right.data()}, static_cast<std::size_t>(texture_w()) * 4, origins_,
-                       out.rgba.data(), static_cast<std::size_t>(width_) * 4);
-    return out;
-  }
-  // Opaque black wherever the eyes do not draw (the gap, and borders when a panel is smaller than
-  // its eye area); the eyes overwrite all of their own pixels.
-  void fill_outside_eyes(std::uint8_t* rgba) const {
-    const auto panel = panel_;
-    const auto fill = [&](int y, int from, int to) {
-      if (from < to)
-        fill_opaque_black(
-            {rgba + (static_cast<std::size_t>(y) * width_ + from) * 4, static_cast<std::size_t>(to - from) * 4});
-    };
-    for (int y = 0; y < height_; ++y) {
-      int from = 0;
-      for (const auto& origin : origins_) {
-        if (!origin || y < origin->second || y >= origin->second + panel[1]) continue;
-        fill(y, from, origin->first);
-        from = origin->first + panel[0];
-      }
-      fill(y, from, width_);
-    }
-  }
-
-  int texture_w() const { return view_w_ / block_[0]; }
-  int texture_h() const { return view_h_ / block_[1]; }
-
-  std::optional<GlCompositor> compositor_;  // none when the tables came from the cache
-  Signal signal_;
-  std::array<int, 2> panel_{0, 0};
-  int view_w_, view_h_, bits_;
-  std::array<int, 2> block_;
-  int width_ = 0, height_ = 0;
-  std::array<std::optional<std::pair<int, int>>, 2> origins_;
-  std::array<std::optional<CompositeTable>, 2> tables_;  // per eye, the CPU path
-  std::array<gl::Texture, 2> views_;
-  gl::Texture packed_;
-  gl::Framebuffer packed_fbo_;
-};
-
 // Collects the first failure of any stage; the others stop when they see it.
 class FirstError {
  public:
@@ -471,11 +334,22 @@ void convert_video(const VideoConvertRequest& r) {
   // Composite thread: owns the GL context.
   std::jthread composite([&] {
     try {
-      PackedFrameRenderer renderer(r, view_w, view_h, bits, aspect, block);
-      size_promise.set_value({renderer.width(), renderer.height()});
+      const PackedLayout layout = packed_layout(r.signal, r.profile.display.resolution);
+      validate_fsaa(r.compositor.fsaa);
+      require_eyes_fit(layout, r.profile.name, r.signal.name, "; use --signal sbs, tab, left or right");
+      // On a software rasteriser 8-bit block means are composited on the CPU from tables recorded
+      // once with the compositor's shaders; tables seen before come from the cache without GL.
+      FrameCompositor compositor(r.profile, r.compositor, layout, nullptr, TableUse::any_views);
+      compositor.prepare_views({view_w, view_h, bits, aspect, block});
+      size_promise.set_value({layout.packed[0], layout.packed[1]});
+      const std::size_t packed_bytes =
+          static_cast<std::size_t>(layout.packed[0]) * layout.packed[1] * bytes_per_pixel(bits);
       while (auto frame = decoded.pop()) {
         if (interrupt_requested || error.failed()) break;
-        if (!packed.push(renderer.render(*frame, buffers))) return;
+        const auto shared = std::make_shared<const StereoVideoFrame>(std::move(*frame));
+        PackedFrame out{0, 0, 8, buffers.take(packed_bytes), 0.0};
+        compositor.render(shared, {}, PackedTarget::bytes(out));
+        if (!packed.push(std::move(out))) return;
       }
       packed.close();
     } catch (...) {

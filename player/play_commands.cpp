@@ -17,18 +17,23 @@ ViewBlockChooser view_blocks_for(const Profile& profile, const CompositorOptions
   };
 }
 
+FrameCompositor::GridPattern calibration_grid_pattern() {
+  return [](const Profile& profile, int width, int height) {
+    StereoPair pair = make_test_pattern(TestPattern::grid, pattern_geometry(profile, width, height));
+    return EyeImages{std::move(pair.left.image), std::move(pair.right.image)};
+  };
+}
+
 void PlayCommands::say(std::string text) {
   state_.dirty = true;
   if (!options_.on_screen_messages) return;
   message_ = std::move(text);
-  renderer_.set_message(message_);
   message_until_ = std::chrono::steady_clock::now() + std::chrono::seconds(2);
 }
 
 void PlayCommands::expire_message() {
   if (message_.empty() || std::chrono::steady_clock::now() <= message_until_) return;
   message_.clear();
-  renderer_.set_message("");
   state_.dirty = true;
 }
 
@@ -49,7 +54,7 @@ void PlayCommands::seek_by(double delta) {
 
 void PlayCommands::change_profile(const Profile& changed, const std::string& what) {
   try {
-    renderer_.set_profile(changed);
+    compositor_.set_profile(changed);
     queue_.reduce_views(view_blocks_for(changed, options_.compositor));
     state_.dirty = true;
     say(what);
@@ -81,7 +86,7 @@ bool PlayCommands::apply(Command command) {
       break;
     case Command::screen_farther:
     case Command::screen_nearer: {
-      Profile p = renderer_.profile();
+      Profile p = compositor_.profile();
       const double now_mm = p.screen.distance_mm > 0 ? p.screen.distance_mm : p.viewing.virtual_image_mm;
       p.screen.distance_mm = command == Command::screen_nearer ? now_mm / 1.25 : now_mm * 1.25;
       change_profile(p, fmt::format("screen distance {:.0f} mm", p.screen.distance_mm));
@@ -89,7 +94,7 @@ bool PlayCommands::apply(Command command) {
     }
     case Command::ipd_narrower:
     case Command::ipd_wider: {
-      Profile p = renderer_.profile();
+      Profile p = compositor_.profile();
       p.viewing.ipd_mm += command == Command::ipd_narrower ? -0.5 : 0.5;
       change_profile(p, fmt::format("IPD {:.1f} mm", p.viewing.ipd_mm));
       break;
@@ -102,10 +107,10 @@ bool PlayCommands::apply(Command command) {
     case Command::calibration_grid:
       state_.calibration = !state_.calibration;
       try {
-        if (state_.current) renderer_.upload(state_.current, state_.calibration);
+        compositor_.prepare(state_.current, overlays());
       } catch (const TestPatternError& e) {
         state_.calibration = false;
-        if (state_.current) renderer_.upload(state_.current, state_.calibration);
+        compositor_.prepare(state_.current, overlays());
         say(fmt::format("no calibration grid: {}", e.what()));
         break;
       }

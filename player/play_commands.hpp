@@ -9,6 +9,7 @@
 #include <string>
 
 #include "compositor/compositor.hpp"
+#include "compositor/frame_compositor.hpp"
 #include "core/frames.hpp"
 #include "hmz_output/display.hpp"
 #include "inputs/stereo_frame_source.hpp"
@@ -16,7 +17,6 @@
 #include "player/frame_queue.hpp"
 #include "player/frame_scheduler.hpp"
 #include "player/key_bindings.hpp"
-#include "player/packed_renderer.hpp"
 #include "player/play_sound.hpp"
 
 namespace nelf::playback {
@@ -25,6 +25,9 @@ namespace nelf::playback {
 // converting from YUV): far less to convert, upload and composite per frame. The block follows
 // the optics.
 ViewBlockChooser view_blocks_for(const Profile& profile, const CompositorOptions& compositor);
+
+// The calibration grid (key c): calibrate's grid pattern at the views' size and the optics.
+FrameCompositor::GridPattern calibration_grid_pattern();
 
 struct PlayState {
   bool paused = false;
@@ -39,11 +42,11 @@ struct PlayState {
 
 class PlayCommands {
  public:
-  PlayCommands(PlayState& state, Display& display, PackedRenderer& renderer, FrameQueue& queue, PlaySound& sound,
+  PlayCommands(PlayState& state, Display& display, FrameCompositor& compositor, FrameQueue& queue, PlaySound& sound,
                FrameScheduler& scheduler, const PlayerOptions& options, std::optional<double> duration_s)
       : state_(state),
         display_(display),
-        renderer_(renderer),
+        compositor_(compositor),
         queue_(queue),
         sound_(sound),
         scheduler_(scheduler),
@@ -56,6 +59,8 @@ class PlayCommands {
   void say(std::string text);
   // Takes the message off the screen once its two seconds are up.
   void expire_message();
+  // What the state asks to be drawn over the frame: the message, the grid, the eyes swapped.
+  FrameOverlays overlays() const { return {message_, state_.calibration, state_.swap_eyes}; }
 
  private:
   void seek_by(double delta_s);
@@ -63,7 +68,7 @@ class PlayCommands {
 
   PlayState& state_;
   Display& display_;
-  PackedRenderer& renderer_;
+  FrameCompositor& compositor_;
   FrameQueue& queue_;
   PlaySound& sound_;
   FrameScheduler& scheduler_;

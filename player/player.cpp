@@ -13,12 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "compositor/cpu/composite_ahead.hpp"
-#include "compositor/cpu/composite_table_cache.hpp"
-#include "compositor/gl/gl_compositor.hpp"
-#include "compositor/overlays/calibration_overlay.hpp"
-#include "compositor/overlays/text_overlay.hpp"
-#include "core/gl/objects.hpp"
+#include "compositor/frame_compositor.hpp"
 #include "core/image_library.hpp"
 #include "core/user_error.hpp"
 #include "hmz_output/audio_output.hpp"
@@ -26,7 +21,6 @@
 #include "player/frame_log.hpp"
 #include "player/frame_queue.hpp"
 #include "player/key_bindings.hpp"
-#include "player/packed_renderer.hpp"
 #include "player/play_commands.hpp"
 #include "player/play_sound.hpp"
 #include "player/refresh_pacing.hpp"
@@ -41,7 +35,6 @@ double seconds_since(Steady::time_point t) { return std::chrono::duration<double
 using playback::decode_loop;
 using playback::FrameLog;
 using playback::FrameQueue;
-using playback::PackedRenderer;
 using playback::PlayCommands;
 using playback::PlaySound;
 using playback::PlayState;
@@ -71,7 +64,17 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     std::fprintf(stderr, "nelf: warning: %s\n", e.what());
   }
   display.context()->make_current();
-  PackedRenderer renderer(display, options);
+  const PackedLayout layout = packed_layout(options.signal, options.profile.display.resolution);
+  FrameCompositor compositor(options.profile, options.compositor, layout, display.context());
+  require_eyes_fit(layout, options.profile.name, options.signal.name);
+  const std::array<int, 2> packed = display.packed_size();
+  for (const auto& origin : layout.origins)
+    if (origin && (origin->first + layout.eye[0] > packed[0] || origin->second + layout.eye[1] > packed[1]))
+      throw UserError(fmt::format("the display's {}x{} frame is smaller than signal {} needs", packed[0], packed[1],
+                                  options.signal.name),
+                      1);
+  compositor.set_grid_pattern(playback::calibration_grid_pattern());
+  const GlPackedTarget target{display.packed_framebuffer(), display.packed_texture(), packed};
   FrameLog log(options.log_frames);
 
   // The master clock: the sound's when there is sound. It starts with the first frame on screen.
@@ -97,7 +100,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   } stop_decoder{queue};
 
   PlayState state;
-  PlayCommands commands(state, display, renderer, queue, sound, scheduler, options, source.duration_s());
+  PlayCommands commands(state, display, compositor, queue, sound, scheduler, options, source.duration_s());
   RenderTime render_time(refresh_period);  // the first render, which compiles shaders, does not count
   RefreshTicker ticker(refresh_period);
   std::int64_t refresh = 0;
@@ -109,8 +112,8 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   // buffers, cold caches), and with the clock running the first refreshes dropped frames waiting
   // for them (2 of 300 at 30 fps in a run of tests/bench/play_pacing.sh).
   const auto start_clock = [&] {
-    renderer.composite_ahead(state.swap_eyes, queue.front(queue_capacity));
-    renderer.wait_for_ahead(std::chrono::milliseconds(300));
+    compositor.composite_ahead(queue.front(queue_capacity), commands.overlays(), target);
+    compositor.wait_for_ahead(std::chrono::milliseconds(300));
     clock.set_paused(false);
   };
 
@@ -163,7 +166,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
           state.show_while_paused = false;
           state.current = std::move(frame);
           const auto t = Steady::now();
-          renderer.upload(state.current, state.calibration);
+          compositor.prepare(state.current, commands.overlays());
           if (log.enabled()) glFinish();  // so that the log says where the time goes
           upload_s = seconds_since(t);
           state.dirty = true;
@@ -179,7 +182,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
     bool ahead = false;
     if (state.dirty) {
       auto t = Steady::now();
-      ahead = renderer.render(state.swap_eyes);
+      ahead = compositor.render(state.current, commands.overlays(), {target});
       if (ahead) ++result.composited_ahead;
       if (log.enabled()) glFinish();
       render_only_s = seconds_since(t);
@@ -215,7 +218,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
       std::vector<double> next_pts;
       for (const auto& f : next) next_pts.push_back(f->pts_s);
       const std::size_t stale = scheduler.stale(clock.now() + refresh_period + seen_after(), next_pts);
-      renderer.composite_ahead(state.swap_eyes, std::span(next).subspan(stale));
+      compositor.composite_ahead(std::span(next).subspan(stale), commands.overlays(), target);
     }
 
     if (!display.vsync()) ticker.sleep_to_next();
