@@ -12,7 +12,7 @@ namespace nelf {
 // Both views of one stereo frame, as tightly packed RGBA of `bits` per channel (8: one byte per
 // channel; 16: native-endian uint16 per channel): width×height pixels, or, when `block` is more
 // than 1×1, (width / block[0])×(height / block[1]) means of block[0]×block[1] pixels each (made
-// while converting from YUV, see StereoFrameSource::reduce_views). width, height and aspect are
+// while converting from YUV, see Source::reduce_views). width, height and aspect are
 // always those of the full view.
 struct StereoVideoFrame {
   int width = 0, height = 0, bits = 8;

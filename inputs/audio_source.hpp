@@ -2,7 +2,7 @@
 // Decoding a media file's audio for playback (`nelf play`): the default audio stream, decoded with
 // libavcodec and resampled with libswresample to interleaved float stereo at the output's rate,
 // each chunk stamped with its presentation time on the video's timeline (seconds from the same
-// origin as StereoFrameSource::pts_s). Damaged packets are skipped and counted, as for video.
+// origin as Source::pts_s). Damaged packets are skipped and counted, as for video.
 #include <cstdint>
 #include <memory>
 #include <optional>

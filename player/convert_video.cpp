@@ -30,7 +30,7 @@ extern "C" {
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
 #include "inputs/ffmpeg_input.hpp"
-#include "inputs/stereo_frame_source.hpp"
+#include "inputs/source.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
@@ -101,14 +101,13 @@ class SourcePacketCarrier {
 
 class EncodedFileSink final : public FrameSink {
  public:
-  EncodedFileSink(const VideoConvertRequest& r, StereoFrameSource& source, int width, int height, int bits,
-                  double origin_s)
+  EncodedFileSink(const VideoConvertRequest& r, Source& source, int width, int height, int bits, double origin_s)
       : source_(source), output_(r.output) {
     if (!source.audio_path().empty() && r.encoder.audio)
       carrier_.emplace(source.audio_path(), origin_s, r.allow_network);
     EncoderSettings settings = r.encoder;
     settings.bits = bits;
-    const AVRational rate = av_d2q(source.frame_rate(), 100000);
+    const AVRational rate = av_d2q(source.info().frame_rate, 100000);
     try {
       encoder_.emplace(r.output, width, height, rate.num, rate.den, settings, carrier_ ? carrier_->format() : nullptr);
     } catch (const std::invalid_argument& e) {
@@ -124,7 +123,7 @@ class EncodedFileSink final : public FrameSink {
   }
   void write(const PackedFrame& frame) override {
     encoder_->write_video(frame);
-    last_end_s_ = frame.pts_seconds + 1.0 / source_.frame_rate();
+    last_end_s_ = frame.pts_seconds + 1.0 / source_.info().frame_rate;
     // Only what starts before this frame ends: the conversion may stop at any frame (--frames, a
     // damaged input), and audio already written past that point could not be taken back.
     if (carrier_) carrier_->carry_until(*encoder_, last_end_s_ - 1e-6, end_s_);
@@ -145,7 +144,7 @@ class EncodedFileSink final : public FrameSink {
   std::string description() const override { return output_; }
 
  private:
-  StereoFrameSource& source_;
+  Source& source_;
   std::string output_;
   std::optional<SourcePacketCarrier> carrier_;
   std::optional<VideoEncoder> encoder_;
@@ -404,7 +403,7 @@ class FirstError {
 // What a sink is opened with, once the packed frame's size is known.
 struct FrameSinkContext {
   const VideoConvertRequest& request;
-  StereoFrameSource& source;
+  Source& source;
   int width, height, bits;
 };
 
@@ -419,7 +418,7 @@ struct FrameSinkDriver {
 constexpr FrameSinkDriver kFrameSinks[] = {
     {"raw", is_raw_output,
      [](const FrameSinkContext& c) {
-       return open_raw_frame_sink(STDOUT_FILENO, c.width, c.height, c.source.frame_rate());
+       return open_raw_frame_sink(STDOUT_FILENO, c.width, c.height, c.source.info().frame_rate);
      }},
     {"image", [](const std::string& o) { return is_image_sequence_pattern(o) || is_image_file_name(o); },
      [](const FrameSinkContext& c) -> std::unique_ptr<FrameSink> {
@@ -449,12 +448,12 @@ bool is_image_sequence_pattern(const std::string& output) {
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
   // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
-  std::unique_ptr<StereoFrameSource> source = open_stereo_frame_source(
-      StereoSourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network,
-                          [&r](int width, int height, double aspect) {
-                            return stereo_prefilter_block(r.profile, r.compositor, width, height, aspect);
-                          },
-                          r.max_pixels});
+  std::unique_ptr<Source> source =
+      open_source(SourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network,
+                                [&r](int width, int height, double aspect) {
+                                  return stereo_prefilter_block(r.profile, r.compositor, width, height, aspect);
+                                },
+                                r.max_pixels});
 
   // The first frame fixes the view size and depth for the whole run.
   auto first = source->next();
@@ -463,9 +462,9 @@ void convert_video(const VideoConvertRequest& r) {
   const double aspect = first->aspect;
   const std::array<int, 2> block = first->block;
 
-  std::optional<long> total = source->expected_frames();
+  std::optional<long> total = source->info().expected_frames;
   if (r.duration_s && total)
-    total = std::min(*total, static_cast<long>(std::lround(*r.duration_s * source->frame_rate())));
+    total = std::min(*total, static_cast<long>(std::lround(*r.duration_s * source->info().frame_rate)));
   if (r.max_frames) total = total ? std::min(*total, *r.max_frames) : *r.max_frames;
 
   BoundedQueue<StereoVideoFrame> decoded(4);

@@ -11,7 +11,7 @@
 
 #include "compositor/cpu/composite_ahead.hpp"
 #include "core/frames.hpp"
-#include "inputs/stereo_frame_source.hpp"
+#include "inputs/source.hpp"
 
 namespace nelf::playback {
 
@@ -66,7 +66,7 @@ class FrameQueue {
     end_ = false;
     changed_.notify_all();
   }
-  // The views of frames decoded from now on as `choose` says (StereoFrameSource::reduce_views);
+  // The views of frames decoded from now on as `choose` says (Source::reduce_views);
   // frames already queued keep theirs.
   void reduce_views(ViewBlockChooser choose) {
     std::lock_guard lock(mutex_);
@@ -130,7 +130,7 @@ class FrameQueue {
 // dropped by the scheduler. (Skipping late frames here as well was measured and is worse when
 // decoding is the bottleneck: each decoded frame is late, so most were thrown away without the
 // decoder catching up; jumping ahead by seeking is worse still with long GOPs.)
-inline void decode_loop(StereoFrameSource& source, FrameQueue& queue) {
+inline void decode_loop(Source& source, FrameQueue& queue) {
   try {
     for (;;) {
       const FrameQueue::Work work = queue.wait_for_work();

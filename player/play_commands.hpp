@@ -11,7 +11,7 @@
 #include "compositor/compositor.hpp"
 #include "core/frames.hpp"
 #include "hmz_output/display.hpp"
-#include "inputs/stereo_frame_source.hpp"
+#include "inputs/source.hpp"
 #include "optics/profile.hpp"
 #include "player/frame_queue.hpp"
 #include "player/frame_scheduler.hpp"

@@ -59,8 +59,7 @@ std::string play_summary(const PlayResult& r) {
   return line;
 }
 
-PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions& options,
-                const std::atomic<bool>* stop) {
+PlayResult play(Display& display, Source& source, const PlayerOptions& options, const std::atomic<bool>* stop) {
   PlayResult result;
   // The on-screen messages draw their text with OpenImageIO, loaded on first use: load it now
   // (~0.3 s) rather than as a hitch at the first key press. Without it the film still plays; the
@@ -85,7 +84,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   clock.set_paused(true);
 
   const double refresh_period = 1.0 / display.refresh_hz();
-  const double fps = source.frame_rate();
+  const double fps = source.info().frame_rate;
   FrameScheduler scheduler(refresh_period, fps > 0 ? 1.0 / fps : 0.0);
   source.reduce_views(view_blocks_for(options.profile, options.compositor));
   constexpr std::size_t queue_capacity = 6;
@@ -97,7 +96,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   } stop_decoder{queue};
 
   PlayState state;
-  PlayCommands commands(state, display, renderer, queue, sound, scheduler, options, source.duration_s());
+  PlayCommands commands(state, display, renderer, queue, sound, scheduler, options, source.info().duration_s);
   RenderTime render_time(refresh_period);  // the first render, which compiles shaders, does not count
   RefreshTicker ticker(refresh_period);
   std::int64_t refresh = 0;

@@ -1,4 +1,4 @@
-#include "inputs/stereo_frame_source.hpp"
+#include "inputs/source.hpp"
 #include "core/printable.hpp"
 
 #include <fmt/format.h>
@@ -8,8 +8,8 @@
 #include <cstring>
 #include <utility>
 
-#include "inputs/synthetic_source.hpp"
 #include "core/user_error.hpp"
+#include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
 
@@ -36,7 +36,7 @@ std::vector<std::uint8_t> to_rgba8(const Image& image) {
   return out;
 }
 
-class SyntheticFrameSource final : public StereoFrameSource {
+class SyntheticFrameSource final : public Source {
  public:
   SyntheticFrameSource(const std::string& spec, double start_s)
       : clip_(parse_synthetic_spec(spec)), next_(static_cast<int>(std::lround(start_s * clip_.settings().fps))) {}
@@ -54,10 +54,15 @@ class SyntheticFrameSource final : public StereoFrameSource {
     ++next_;
     return f;
   }
-  double frame_rate() const override { return clip_.settings().fps; }
-  std::optional<long> expected_frames() const override { return clip_.frame_count() - first_; }
-  std::optional<double> duration_s() const override {
-    return static_cast<double>(clip_.frame_count() - first_) / clip_.settings().fps;
+  SourceInfo info() const override {
+    const SyntheticClipSettings& s = clip_.settings();
+    SourceInfo info;
+    info.frame_rate = s.fps;
+    info.expected_frames = clip_.frame_count() - first_;
+    info.duration_s = static_cast<double>(clip_.frame_count() - first_) / s.fps;
+    info.seekable = true;
+    info.description = fmt::format("synthetic clip, two {}x{} views at {} fps", s.eye_width, s.eye_height, s.fps);
+    return info;
   }
   void seek(double seconds) override {
     const int target = first_ + static_cast<int>(std::lround(std::max(0.0, seconds) * clip_.settings().fps));
@@ -76,9 +81,9 @@ class SyntheticFrameSource final : public StereoFrameSource {
   int first_ = next_;
 };
 
-class FileFrameSource final : public StereoFrameSource {
+class FileFrameSource final : public Source {
  public:
-  FileFrameSource(const StereoSourceRequest& r) : path_(r.input), source_(open(r.input, r)) {
+  FileFrameSource(const SourceRequest& r) : path_(r.input), source_(open(r.input, r)) {
     if (r.start_s) source_.seek(*r.start_s);
     pending_ = source_.next_frame();
     if (!pending_ && r.start_s && source_.info().duration_s && *r.start_s >= *source_.info().duration_s)
@@ -126,10 +131,10 @@ class FileFrameSource final : public StereoFrameSource {
       }
     }
     if (r.view_block) reduce_views(r.view_block);
-    if (!r.quiet)
-      fmt::print(stderr, "nelf: {}: {}x{} {}, layout {}{} ({})\n", printable(r.input), source_.info().width,
-                 source_.info().height, source_.info().video_codec, to_string(decision_.layout),
-                 decision_.swap_eyes ? " swapped" : "", to_string(decision_.rule));
+    description_ = fmt::format("{}: {}x{} {}, layout {}{} ({})", r.input, source_.info().width, source_.info().height,
+                               source_.info().video_codec, to_string(decision_.layout),
+                               decision_.swap_eyes ? " swapped" : "", to_string(decision_.rule));
+    if (!r.quiet) fmt::print(stderr, "nelf: {}\n", printable(description_));
   }
 
   std::optional<StereoVideoFrame> next() override {
@@ -178,27 +183,26 @@ class FileFrameSource final : public StereoFrameSource {
     return out;
   }
 
-  double frame_rate() const override {
-    const double fps = source_.info().fps > 0 ? source_.info().fps : 25.0;
-    return decision_.layout == StereoLayout::alt ? fps / 2 : fps;
-  }
-  std::optional<long> expected_frames() const override {
-    const VideoInfo& info = source_.info();
-    std::optional<double> frames;
-    if (info.frame_count)
-      frames = static_cast<double>(*info.frame_count);
-    else if (info.duration_s && info.fps > 0)
-      frames = *info.duration_s * info.fps;
-    if (!frames) return std::nullopt;
-    if (decision_.layout == StereoLayout::alt) *frames /= 2;
-    return static_cast<long>(std::lround(*frames));
-  }
   std::string audio_path() const override { return path_; }
   double origin_s() const override { return origin_s_; }
-  std::optional<double> duration_s() const override {
-    const auto& d = source_.info().duration_s;
-    if (!d) return std::nullopt;
-    return std::max(0.0, *d - (origin_s_ - source_.info().start_time_s));
+  SourceInfo info() const override {
+    const VideoInfo& video = source_.info();
+    SourceInfo info;
+    const double fps = video.fps > 0 ? video.fps : 25.0;
+    info.frame_rate = decision_.layout == StereoLayout::alt ? fps / 2 : fps;
+    std::optional<double> frames;
+    if (video.frame_count)
+      frames = static_cast<double>(*video.frame_count);
+    else if (video.duration_s && video.fps > 0)
+      frames = *video.duration_s * video.fps;
+    if (frames) {
+      if (decision_.layout == StereoLayout::alt) *frames /= 2;
+      info.expected_frames = static_cast<long>(std::lround(*frames));
+    }
+    if (video.duration_s) info.duration_s = std::max(0.0, *video.duration_s - (origin_s_ - video.start_time_s));
+    info.seekable = video.seekable && (!right_ || right_->info().seekable);
+    info.description = description_;
+    return info;
   }
   void seek(double seconds) override {
     // The source's own clock starts at its start time; pts_s 0 is origin_s_.
@@ -244,7 +248,7 @@ class FileFrameSource final : public StereoFrameSource {
   }
 
  private:
-  static VideoSource open(const std::string& path, const StereoSourceRequest& r) {
+  static VideoSource open(const std::string& path, const SourceRequest& r) {
     try {
       return VideoSource(path, VideoSourceOptions{r.allow_network, true, r.max_pixels});
     } catch (const VideoError& e) {
@@ -263,6 +267,7 @@ class FileFrameSource final : public StereoFrameSource {
   int height() const { return source_.info().height; }
 
   std::string path_;
+  std::string description_;
   VideoSource source_;
   std::optional<VideoSource> right_;
   std::optional<VideoFrame> pending_;
@@ -276,7 +281,11 @@ class FileFrameSource final : public StereoFrameSource {
 
 }  // namespace
 
-std::unique_ptr<StereoFrameSource> open_stereo_frame_source(const StereoSourceRequest& request) {
+void Source::seek(double /*seconds*/) {
+  throw UserError(fmt::format("{}: this input cannot seek", info().description), 1);
+}
+
+std::unique_ptr<Source> open_source(const SourceRequest& request) {
   if (is_synthetic_spec(request.input)) {
     try {
       return std::make_unique<SyntheticFrameSource>(request.input, request.start_s.value_or(0.0));

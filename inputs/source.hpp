@@ -1,8 +1,8 @@
 #pragma once
-// Stereo frames from a video input, split into the two views the way the layout says: a media file
-// in any layout (sbs, tab, fp, mono …, `alt` frame-sequential, `pair` = a second file for the right
-// view) or the built-in `synthetic:` clip. Shared by `nelf convert` (video) and `nelf play`, so that
-// both honour --layout, --right and --swap-eyes identically.
+// A Source: stereo frames from an input, split into the two views the way the layout says: a media
+// file in any layout (sbs, tab, fp, mono …, `alt` frame-sequential, `pair` = a second file for the
+// right view) or the built-in `synthetic:` clip. Shared by `nelf convert` (video) and `nelf play`,
+// so that both honour --layout, --right and --swap-eyes identically.
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -22,7 +22,7 @@ namespace nelf {
 // (e.g. the compositor's prefilter_block for both eyes); the source only honours it.
 using ViewBlockChooser = std::function<std::array<int, 2>(int view_width, int view_height, double aspect)>;
 
-struct StereoSourceRequest {
+struct SourceRequest {
   std::string input;                   // a media file or `synthetic:[options]`
   std::string right;                   // second input for layout pair
   std::optional<StereoLayout> layout;  // nullopt: detect
@@ -34,19 +34,27 @@ struct StereoSourceRequest {
   std::int64_t max_pixels = kDefaultMaxPixels;  // --max-pixels: larger frames are refused undecoded
 };
 
-class StereoFrameSource {
+// What a source says about its stream once it is open.
+struct SourceInfo {
+  double frame_rate = 0.0;              // frames per second of the stereo frames (alt: half the file's)
+  std::optional<double> duration_s;     // from pts_s 0, when known
+  std::optional<long> expected_frames;  // stereo frames from pts_s 0, when known
+  bool seekable = false;                // seek() can succeed
+  bool live = false;                    // next() waits for frames made in real time (a capture)
+  std::string description;              // one line naming the input, its size and layout
+};
+
+class Source {
  public:
-  virtual ~StereoFrameSource() = default;
+  virtual ~Source() = default;
+  virtual SourceInfo info() const = 0;
   // The next frame, or nullopt at the end. Damaged data is skipped and counted (lost_frames());
   // unrecoverable problems throw UserError.
   virtual std::optional<StereoVideoFrame> next() = 0;
-  virtual double frame_rate() const = 0;
-  virtual std::optional<long> expected_frames() const = 0;
-  // Input duration in seconds from origin_s() when known.
-  virtual std::optional<double> duration_s() const = 0;
   // Positions the source so that next() returns the frames at or after `seconds` (on the pts_s
-  // timeline, i.e. from origin_s()). Throws UserError when the input cannot seek.
-  virtual void seek(double seconds) = 0;
+  // timeline, i.e. from origin_s()). Throws UserError (one line) when the input cannot seek: the
+  // default, for sources whose info() says seekable is false.
+  virtual void seek(double seconds);
   // From the next frame on (seeks included), deliver the views block-averaged as `choose` says for
   // this input's view size, when the input allows it (one block for both views, a stream swscale
   // can crop: see VideoSource::reduce_regions); otherwise, or with an empty `choose` or {1, 1},
@@ -68,6 +76,6 @@ class StereoFrameSource {
 // Opens the input (and --right), detects the layout from the first frame and prints one line
 // describing it unless quiet. Throws UserError: status 1 for inputs that cannot be used, 2 for
 // options that contradict the input (same messages as `nelf convert`).
-std::unique_ptr<StereoFrameSource> open_stereo_frame_source(const StereoSourceRequest& request);
+std::unique_ptr<Source> open_source(const SourceRequest& request);
 
 }  // namespace nelf
