@@ -62,6 +62,7 @@ class SyntheticFrameSource final : public Source {
     info.duration_s = static_cast<double>(clip_.frame_count() - first_) / s.fps;
     info.seekable = true;
     info.description = fmt::format("synthetic clip, two {}x{} views at {} fps", s.eye_width, s.eye_height, s.fps);
+    info.view = {s.eye_width, s.eye_height, static_cast<double>(s.eye_width) / s.eye_height};
     return info;
   }
   void seek(double seconds) override {
@@ -130,7 +131,6 @@ class FileFrameSource final : public Source {
         throw UserError(fmt::format("{}: {}", r.input, e.what()), 1);
       }
     }
-    if (r.view_block) reduce_views(r.view_block);
     description_ = fmt::format("{}: {}x{} {}, layout {}{} ({})", r.input, source_.info().width, source_.info().height,
                                source_.info().video_codec, to_string(decision_.layout),
                                decision_.swap_eyes ? " swapped" : "", to_string(decision_.rule));
@@ -202,6 +202,7 @@ class FileFrameSource final : public Source {
     if (video.duration_s) info.duration_s = std::max(0.0, *video.duration_s - (origin_s_ - video.start_time_s));
     info.seekable = video.seekable && (!right_ || right_->info().seekable);
     info.description = description_;
+    info.view = view_geometry();
     return info;
   }
   void seek(double seconds) override {
@@ -218,14 +219,12 @@ class FileFrameSource final : public Source {
   // The compositor's first prefilter pass (a block mean over the view) done by swscale while it
   // converts the decoded YUV: the GL stage then uploads and reads 1/block² of the texels, and the
   // full-resolution RGBA frame is never made. VideoSource keeps the regions across seeks.
-  std::array<int, 2> reduce_views(const ViewBlockChooser& choose) override {
-    if (decision_.layout == StereoLayout::pair) return block_;  // two decoders: whole frames
+  ViewFormat negotiate(const ViewFormat& format) override {
+    if (decision_.layout == StereoLayout::pair) return {block_};  // two decoders: whole frames
     const bool whole = decision_.layout == StereoLayout::alt;
     const PixelRect left = whole ? PixelRect{0, 0, alt_width_, alt_height_} : regions_.left;
     const PixelRect right = whole ? left : regions_.right;
-    const double aspect = whole ? alt_aspect_ : regions_.display_aspect;
-    std::array<int, 2> block{1, 1};
-    if (choose) block = choose(left.width, left.height, aspect);
+    std::array<int, 2> block = format.block;
     std::vector<ReducedRegion> wanted;
     if (block[0] > 1 || block[1] > 1) {
       wanted.push_back({left.x, left.y, left.width, left.height, block[0], block[1]});
@@ -241,7 +240,7 @@ class FileFrameSource final : public Source {
       throw UserError(e.what(), 1);
     }
     block_ = block;
-    return block_;
+    return {block_};
   }
   std::int64_t lost_frames() const override {
     return source_.stats().problems() + (right_ ? right_->stats().problems() : 0);
@@ -263,6 +262,11 @@ class FileFrameSource final : public Source {
       throw UserError(e.what(), 1);
     }
   }
+  ViewGeometry view_geometry() const {
+    if (decision_.layout == StereoLayout::alt || decision_.layout == StereoLayout::pair)
+      return {alt_width_, alt_height_, alt_aspect_};
+    return {regions_.left.width, regions_.left.height, regions_.display_aspect};
+  }
   int width() const { return source_.info().width; }
   int height() const { return source_.info().height; }
 
@@ -273,10 +277,10 @@ class FileFrameSource final : public Source {
   std::optional<VideoFrame> pending_;
   LayoutDecision decision_;
   ViewRegions regions_;
-  int alt_width_ = 0, alt_height_ = 0;  // layout alt: each frame is a whole view of this size
+  int alt_width_ = 0, alt_height_ = 0;  // layouts alt and pair: each frame is a whole view of this size
   double alt_aspect_ = 0.0;
   double origin_s_ = 0.0;
-  std::array<int, 2> block_{1, 1};  // what reduce_views() set
+  std::array<int, 2> block_{1, 1};  // what negotiate() set
 };
 
 }  // namespace

@@ -5,7 +5,6 @@
 // so that both honour --layout, --right and --swap-eyes identically.
 #include <array>
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -17,11 +16,6 @@
 
 namespace nelf {
 
-// Which block of pixels the caller wants averaged into each delivered pixel of a view of
-// `view_width`×`view_height` pixels shown at `aspect` ({1, 1}: whole views). The caller decides
-// (e.g. the compositor's prefilter_block for both eyes); the source only honours it.
-using ViewBlockChooser = std::function<std::array<int, 2>(int view_width, int view_height, double aspect)>;
-
 struct SourceRequest {
   std::string input;                   // a media file or `synthetic:[options]`
   std::string right;                   // second input for layout pair
@@ -30,7 +24,6 @@ struct SourceRequest {
   std::optional<double> start_s;                // start here (seconds from the start of the input)
   bool quiet = false;                           // no line describing the input (warnings are printed all the same)
   bool allow_network = false;                   // FFmpeg protocols beyond file and pipe
-  ViewBlockChooser view_block;                  // empty: whole views; else as reduce_views() from the first frame
   std::int64_t max_pixels = kDefaultMaxPixels;  // --max-pixels: larger frames are refused undecoded
 };
 
@@ -42,6 +35,7 @@ struct SourceInfo {
   bool seekable = false;                // seek() can succeed
   bool live = false;                    // next() waits for frames made in real time (a capture)
   std::string description;              // one line naming the input, its size and layout
+  ViewGeometry view;                    // of every frame; what negotiate() formats are sized from
 };
 
 class Source {
@@ -55,12 +49,12 @@ class Source {
   // timeline, i.e. from origin_s()). Throws UserError (one line) when the input cannot seek: the
   // default, for sources whose info() says seekable is false.
   virtual void seek(double seconds);
-  // From the next frame on (seeks included), deliver the views block-averaged as `choose` says for
-  // this input's view size, when the input allows it (one block for both views, a stream swscale
-  // can crop: see VideoSource::reduce_regions); otherwise, or with an empty `choose` or {1, 1},
-  // whole views. Returns the block the next frames carry. The synthetic source and pair inputs
-  // always deliver whole views.
-  virtual std::array<int, 2> reduce_views(const ViewBlockChooser& /*choose*/) { return {1, 1}; }
+  // From the next frame on (seeks included), deliver the views in the `wanted` format when the
+  // input allows it (one block for both views, a stream swscale can crop: see
+  // VideoSource::reduce_regions); otherwise whole views. Returns the format the next frames carry.
+  // The caller asks once it knows info().view, and again when what it wants changes. The default
+  // (the synthetic source, pair inputs, stills) always delivers whole views.
+  virtual ViewFormat negotiate(const ViewFormat& /*wanted*/) { return {}; }
   // The container whose audio/subtitles go with the video (opened separately), if any.
   virtual std::string audio_path() const { return {}; }
   virtual bool has_generated_audio() const { return false; }

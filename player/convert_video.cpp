@@ -447,13 +447,11 @@ bool is_image_sequence_pattern(const std::string& output) {
 
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
+  std::unique_ptr<Source> source = open_source(
+      SourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels});
   // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
-  std::unique_ptr<Source> source =
-      open_source(SourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network,
-                                [&r](int width, int height, double aspect) {
-                                  return stereo_prefilter_block(r.profile, r.compositor, width, height, aspect);
-                                },
-                                r.max_pixels});
+  const ViewGeometry view = source->info().view;
+  source->negotiate({stereo_prefilter_block(r.profile, r.compositor, view.width, view.height, view.aspect)});
 
   // The first frame fixes the view size and depth for the whole run.
   auto first = source->next();

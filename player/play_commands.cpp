@@ -11,10 +11,8 @@
 
 namespace nelf::playback {
 
-ViewBlockChooser view_blocks_for(const Profile& profile, const CompositorOptions& compositor) {
-  return [profile, compositor](int width, int height, double aspect) {
-    return stereo_prefilter_block(profile, compositor, width, height, aspect);
-  };
+ViewFormat view_format_for(const Profile& profile, const CompositorOptions& compositor, const ViewGeometry& view) {
+  return {stereo_prefilter_block(profile, compositor, view.width, view.height, view.aspect)};
 }
 
 void PlayCommands::say(std::string text) {
@@ -50,7 +48,7 @@ void PlayCommands::seek_by(double delta) {
 void PlayCommands::change_profile(const Profile& changed, const std::string& what) {
   try {
     renderer_.set_profile(changed);
-    queue_.reduce_views(view_blocks_for(changed, options_.compositor));
+    queue_.negotiate(view_format_for(changed, options_.compositor, view_));
     state_.dirty = true;
     say(what);
   } catch (const std::exception& e) {

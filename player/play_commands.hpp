@@ -24,7 +24,7 @@ namespace nelf::playback {
 // Views as the prefilter's block means where the input allows (swscale makes them while
 // converting from YUV): far less to convert, upload and composite per frame. The block follows
 // the optics.
-ViewBlockChooser view_blocks_for(const Profile& profile, const CompositorOptions& compositor);
+ViewFormat view_format_for(const Profile& profile, const CompositorOptions& compositor, const ViewGeometry& view);
 
 struct PlayState {
   bool paused = false;
@@ -40,7 +40,8 @@ struct PlayState {
 class PlayCommands {
  public:
   PlayCommands(PlayState& state, Display& display, PackedRenderer& renderer, FrameQueue& queue, PlaySound& sound,
-               FrameScheduler& scheduler, const PlayerOptions& options, std::optional<double> duration_s)
+               FrameScheduler& scheduler, const PlayerOptions& options, std::optional<double> duration_s,
+               ViewGeometry view)
       : state_(state),
         display_(display),
         renderer_(renderer),
@@ -48,7 +49,8 @@ class PlayCommands {
         sound_(sound),
         scheduler_(scheduler),
         options_(options),
-        duration_s_(duration_s) {}
+        duration_s_(duration_s),
+        view_(view) {}
 
   // Carries out `command`; false for quit.
   bool apply(Command command);
@@ -69,6 +71,7 @@ class PlayCommands {
   FrameScheduler& scheduler_;
   const PlayerOptions& options_;
   std::optional<double> duration_s_;
+  ViewGeometry view_;          // the source's, for the view format a change of the optics asks for
   std::size_t help_line_ = 0;  // the next line of the key help that h shows
   std::string message_;
   std::chrono::steady_clock::time_point message_until_{};

@@ -47,7 +47,7 @@ using playback::PlaySound;
 using playback::PlayState;
 using playback::RefreshTicker;
 using playback::RenderTime;
-using playback::view_blocks_for;
+using playback::view_format_for;
 
 }  // namespace
 
@@ -84,9 +84,10 @@ PlayResult play(Display& display, Source& source, const PlayerOptions& options, 
   clock.set_paused(true);
 
   const double refresh_period = 1.0 / display.refresh_hz();
-  const double fps = source.info().frame_rate;
+  const SourceInfo info = source.info();
+  const double fps = info.frame_rate;
   FrameScheduler scheduler(refresh_period, fps > 0 ? 1.0 / fps : 0.0);
-  source.reduce_views(view_blocks_for(options.profile, options.compositor));
+  source.negotiate(view_format_for(options.profile, options.compositor, info.view));
   constexpr std::size_t queue_capacity = 6;
   FrameQueue queue(queue_capacity);
   std::jthread decoder([&] { decode_loop(source, queue); });
@@ -96,7 +97,7 @@ PlayResult play(Display& display, Source& source, const PlayerOptions& options, 
   } stop_decoder{queue};
 
   PlayState state;
-  PlayCommands commands(state, display, renderer, queue, sound, scheduler, options, source.info().duration_s);
+  PlayCommands commands(state, display, renderer, queue, sound, scheduler, options, info.duration_s, info.view);
   RenderTime render_time(refresh_period);  // the first render, which compiles shaders, does not count
   RefreshTicker ticker(refresh_period);
   std::int64_t refresh = 0;

@@ -1,5 +1,5 @@
-// Source: views delivered as block means when the caller asks (reduce_views), across
-// seeks and changes of the block.
+// Source: views delivered as block means when the caller negotiates them, across seeks and
+// changes of the block.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -31,8 +31,8 @@ double channel_mean(const std::vector<std::uint8_t>& rgba, int c) {
   return sum / static_cast<double>(rgba.size() / 4) / 255.0;
 }
 
-SourceRequest request_for(const std::string& input, ViewBlockChooser choose) {
-  return SourceRequest{input, "", StereoLayout::sbs, false, std::nullopt, true, false, std::move(choose)};
+SourceRequest request_for(const std::string& input) {
+  return SourceRequest{input, "", StereoLayout::sbs, false, std::nullopt, true, false};
 }
 
 // Red left view, blue right view, 64×36 each, 20 frames at 10 fps.
@@ -54,15 +54,12 @@ void expect_views(const StereoVideoFrame& f, std::array<int, 2> block) {
   EXPECT_LT(channel_mean(f.right, 0), 0.1);
 }
 
-TEST_F(StereoFrameSourceTest, DeliversTheRequestedBlockMeansFromTheFirstFrameOn) {
-  std::vector<std::array<double, 3>> asked;
-  auto source = open_source(request_for(make_sbs_clip(dir), [&](int w, int h, double aspect) {
-    asked.push_back({static_cast<double>(w), static_cast<double>(h), aspect});
-    return std::array<int, 2>{4, 4};
-  }));
-  ASSERT_EQ(asked.size(), 1u);
-  EXPECT_EQ(asked[0][0], 64);  // the view, not the frame
-  EXPECT_EQ(asked[0][1], 36);
+TEST_F(StereoFrameSourceTest, DeliversTheNegotiatedBlockMeansFromTheFirstFrameOn) {
+  auto source = open_source(request_for(make_sbs_clip(dir)));
+  const ViewGeometry view = source->info().view;
+  EXPECT_EQ(view.width, 64);  // the view, not the frame
+  EXPECT_EQ(view.height, 36);
+  EXPECT_EQ(source->negotiate({{4, 4}}), (ViewFormat{{4, 4}}));
   const auto first = source->next();
   ASSERT_TRUE(first);
   expect_views(*first, {4, 4});
@@ -70,7 +67,8 @@ TEST_F(StereoFrameSourceTest, DeliversTheRequestedBlockMeansFromTheFirstFrameOn)
 }
 
 TEST_F(StereoFrameSourceTest, ASeekKeepsTheViewsReduced) {
-  auto source = open_source(request_for(make_sbs_clip(dir), [](int, int, double) { return std::array<int, 2>{2, 3}; }));
+  auto source = open_source(request_for(make_sbs_clip(dir)));
+  source->negotiate({{2, 3}});
   ASSERT_TRUE(source->next());
   ASSERT_TRUE(source->next());
   source->seek(1.0);
@@ -86,19 +84,16 @@ TEST_F(StereoFrameSourceTest, ASeekKeepsTheViewsReduced) {
 }
 
 TEST_F(StereoFrameSourceTest, TheBlockCanChangeMidStreamAndBackToWholeViews) {
-  auto source = open_source(request_for(make_sbs_clip(dir), {}));
+  auto source = open_source(request_for(make_sbs_clip(dir)));
   const auto whole = source->next();
   ASSERT_TRUE(whole);
   expect_views(*whole, {1, 1});
-  EXPECT_EQ(source->reduce_views([](int, int, double) {
-    return std::array<int, 2>{4, 2};
-  }),
-            (std::array<int, 2>{4, 2}));
+  EXPECT_EQ(source->negotiate({{4, 2}}), (ViewFormat{{4, 2}}));
   const auto reduced = source->next();
   ASSERT_TRUE(reduced);
   EXPECT_NEAR(reduced->pts_s, 0.1, 1e-6);  // no frame lost or repeated by the change
   expect_views(*reduced, {4, 2});
-  EXPECT_EQ(source->reduce_views({}), (std::array<int, 2>{1, 1}));
+  EXPECT_EQ(source->negotiate({}), (ViewFormat{{1, 1}}));
   const auto back = source->next();
   ASSERT_TRUE(back);
   EXPECT_NEAR(back->pts_s, 0.2, 1e-6);
@@ -106,7 +101,8 @@ TEST_F(StereoFrameSourceTest, TheBlockCanChangeMidStreamAndBackToWholeViews) {
 }
 
 TEST_F(StereoFrameSourceTest, ABlockThatDoesNotDivideTheViewGivesWholeViews) {
-  auto source = open_source(request_for(make_sbs_clip(dir), [](int, int, double) { return std::array<int, 2>{5, 5}; }));
+  auto source = open_source(request_for(make_sbs_clip(dir)));
+  EXPECT_EQ(source->negotiate({{5, 5}}), (ViewFormat{{1, 1}}));
   const auto f = source->next();
   ASSERT_TRUE(f);
   expect_views(*f, {1, 1});
@@ -115,11 +111,8 @@ TEST_F(StereoFrameSourceTest, ABlockThatDoesNotDivideTheViewGivesWholeViews) {
 TEST_F(StereoFrameSourceTest, ChangingTheBlockBeforeTheFirstFrameReconvertsIt) {
   // The first frame is decoded while opening (layout detection); asking afterwards must not hand
   // it out at the old size.
-  auto source = open_source(request_for(make_sbs_clip(dir), {}));
-  EXPECT_EQ(source->reduce_views([](int, int, double) {
-    return std::array<int, 2>{2, 2};
-  }),
-            (std::array<int, 2>{2, 2}));
+  auto source = open_source(request_for(make_sbs_clip(dir)));
+  EXPECT_EQ(source->negotiate({{2, 2}}), (ViewFormat{{2, 2}}));
   const auto first = source->next();
   ASSERT_TRUE(first);
   EXPECT_NEAR(first->pts_s, 0.0, 1e-6);
@@ -127,17 +120,13 @@ TEST_F(StereoFrameSourceTest, ChangingTheBlockBeforeTheFirstFrameReconvertsIt) {
 }
 
 TEST_F(StereoFrameSourceTest, SyntheticSourceAlwaysDeliversWholeViews) {
-  auto source = open_source(request_for("synthetic:duration=1", [](int, int, double) {
-    return std::array<int, 2>{2, 2};
-  }));
-  EXPECT_EQ(source->reduce_views([](int, int, double) {
-    return std::array<int, 2>{2, 2};
-  }),
-            (std::array<int, 2>{1, 1}));
+  auto source = open_source(request_for("synthetic:duration=1"));
+  EXPECT_EQ(source->negotiate({{2, 2}}), (ViewFormat{{1, 1}}));
   const auto f = source->next();
   ASSERT_TRUE(f);
   EXPECT_EQ(f->block, (std::array<int, 2>{1, 1}));
   EXPECT_EQ(f->left.size(), static_cast<std::size_t>(f->width) * f->height * 4);
+  EXPECT_EQ(source->info().view, (ViewGeometry{f->width, f->height, f->aspect}));
 }
 
 // A source that does not override seek() (a live capture, say) refuses it in one line naming the
@@ -167,7 +156,7 @@ TEST(SourceDefaults, ASourceThatCannotSeekRefusesInOneLine) {
 }
 
 TEST_F(StereoFrameSourceTest, AFileSaysItsRateFramesDurationAndThatItCanSeek) {
-  auto source = open_source(request_for(make_sbs_clip(dir), {}));
+  auto source = open_source(request_for(make_sbs_clip(dir)));
   const SourceInfo info = source->info();
   EXPECT_DOUBLE_EQ(info.frame_rate, 10.0);
   ASSERT_TRUE(info.duration_s);

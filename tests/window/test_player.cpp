@@ -124,7 +124,7 @@ TEST_F(PlayerWindowTest, PlaysTheClipInThePackedLayoutWithEachEyesContentAndFram
                     std::vector<float>(l.data(), l.data() + static_cast<std::size_t>(l.width()) * l.height() * 4)});
   };
 
-  auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
+  auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
   const PlayResult result = play(*display, *source, options);
   EXPECT_EQ(result.end, PlayEnd::end_of_file);
   ASSERT_GE(seen.size(), 5u) << "too few frames rendered";
@@ -159,7 +159,7 @@ TEST_F(PlayerWindowTest, SwapEyesPutsTheFirstStoredViewOnTheRight) {
     left_means.push_back(mean_of(read_back(d.packed_framebuffer(), left.x + 560, left.y + 315, 160, 90)));
   };
   std::atomic<bool> stop{false};
-  auto source = open_source(SourceRequest{clip.string(), "", StereoLayout::sbs, true, std::nullopt, true, false, {}});
+  auto source = open_source(SourceRequest{clip.string(), "", StereoLayout::sbs, true, std::nullopt, true, false});
   // Stop after a few frames: this test is about the routing only.
   auto original = options.after_render;
   options.after_render = [&](const Display& d, double pts) {
@@ -181,14 +181,14 @@ TEST_F(PlayerWindowTest, ClosingTheWindowEndsPlaybackCleanly) {
   options.after_render = [&](const Display&, double) {
     if (++rendered == 3) glfwSetWindowShouldClose(glfwGetCurrentContext(), GLFW_TRUE);
   };
-  auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
+  auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
   const PlayResult result = play(*display, *source, options);
   EXPECT_EQ(result.end, PlayEnd::window_closed);
   EXPECT_EQ(result.counters.shown, 3);
 }
 
 // A source that records the block of each frame it hands out; with `allow_reduction` false it
-// ignores reduce_views (whole views, as before the player asked for block means).
+// refuses every view format but whole views (as before the player asked for block means).
 class RecordingSource final : public Source {
  public:
   RecordingSource(std::unique_ptr<Source> inner, bool allow_reduction)
@@ -200,9 +200,7 @@ class RecordingSource final : public Source {
   }
   SourceInfo info() const override { return inner_->info(); }
   void seek(double seconds) override { inner_->seek(seconds); }
-  std::array<int, 2> reduce_views(const ViewBlockChooser& choose) override {
-    return allow_ ? inner_->reduce_views(choose) : std::array<int, 2>{1, 1};
-  }
+  ViewFormat negotiate(const ViewFormat& wanted) override { return allow_ ? inner_->negotiate(wanted) : ViewFormat{}; }
   std::vector<std::array<int, 2>> blocks;
 
  private:
@@ -230,7 +228,7 @@ TEST_F(PlayerWindowTest, PlaysFromTheCompositorsBlockMeansWithTheSameImageAsFrom
   for (bool reduce : {true, false}) {
     stop = false;
     RecordingSource source(
-        open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}}), reduce);
+        open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false}), reduce);
     play(*display, source, options, &stop);
     blocks[reduce ? 0 : 1] = source.blocks;
   }
@@ -313,7 +311,7 @@ TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessag
         pressed = true;
       }
     };
-    auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
+    auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
     const PlayResult result = play(*display, *source, options);
     EXPECT_EQ(result.end, PlayEnd::end_of_file);
     ASSERT_TRUE(pressed);
@@ -455,7 +453,7 @@ TEST_F(PlayerWindowTest, NoFrameCompositedAheadShowsAStateAKeyHasChanged) {
       shown[path][{typed, pts}] = Frame{panel(d, left), panel(d, right)};
       if (typed < keys.size() && pts >= keys[typed].first - lead) display.type(keys[typed++].second);
     };
-    auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
+    auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
     results[path] = play(display, *source, options);
     EXPECT_EQ(results[path].end, PlayEnd::end_of_file);
     ASSERT_EQ(typed, keys.size());
