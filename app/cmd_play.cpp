@@ -10,7 +10,7 @@
 #include "core/printable.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/display_drivers.hpp"
-#include "inputs/source.hpp"
+#include "inputs/source_drivers.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/video_source.hpp"
 #include "player/interrupt.hpp"

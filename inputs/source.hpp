@@ -26,6 +26,7 @@ struct SourceRequest {
   bool allow_network = false;                   // FFmpeg protocols beyond file and pipe
   std::int64_t max_pixels = kDefaultMaxPixels;  // --max-pixels: larger frames are refused undecoded
 };
+// Opened by the driver table: inputs/source_drivers.hpp.
 
 // What a source says about its stream once it is open.
 struct SourceInfo {
@@ -66,10 +67,5 @@ class Source {
   // Source time (s, on the container's clock) that becomes pts_s 0.
   virtual double origin_s() const { return 0.0; }
 };
-
-// Opens the input (and --right), detects the layout from the first frame and prints one line
-// describing it unless quiet. Throws UserError: status 1 for inputs that cannot be used, 2 for
-// options that contradict the input (same messages as `nelf convert`).
-std::unique_ptr<Source> open_source(const SourceRequest& request);
 
 }  // namespace nelf

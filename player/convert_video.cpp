@@ -30,7 +30,7 @@ extern "C" {
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
 #include "inputs/ffmpeg_input.hpp"
-#include "inputs/source.hpp"
+#include "inputs/source_drivers.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"

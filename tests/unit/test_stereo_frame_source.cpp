@@ -2,12 +2,13 @@
 // changes of the block.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
 
 #include "core/user_error.hpp"
-#include "inputs/source.hpp"
+#include "inputs/source_drivers.hpp"
 #include "inputs/video_source.hpp"
 #include "support/media.hpp"
 #include "support/test_support.hpp"
@@ -127,6 +128,20 @@ TEST_F(StereoFrameSourceTest, SyntheticSourceAlwaysDeliversWholeViews) {
   EXPECT_EQ(f->block, (std::array<int, 2>{1, 1}));
   EXPECT_EQ(f->left.size(), static_cast<std::size_t>(f->width) * f->height * 4);
   EXPECT_EQ(source->info().view, (ViewGeometry{f->width, f->height, f->aspect}));
+}
+
+TEST(SourceDrivers, EachRequestGoesToTheFirstRowThatAcceptsItAndTheFileDriverTakesTheRest) {
+  const auto drivers = source_drivers();
+  ASSERT_GE(drivers.size(), 2u);
+  EXPECT_EQ(drivers.back().name, "file");
+  for (const SourceDriver& driver : drivers) {
+    SCOPED_TRACE(std::string(driver.name));
+    EXPECT_FALSE(driver.help.empty());
+    EXPECT_EQ(std::count(driver.help.begin(), driver.help.end(), '\n'), 0);
+  }
+  EXPECT_EQ(source_driver_for(request_for("synthetic:duration=1")).name, "synthetic");
+  EXPECT_EQ(source_driver_for(request_for("movie.mkv")).name, "file");
+  EXPECT_EQ(source_driver_for(request_for("https://example.com/a.mp4")).name, "file");
 }
 
 // A source that does not override seek() (a live capture, say) refuses it in one line naming the

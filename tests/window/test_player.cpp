@@ -21,6 +21,7 @@
 #include "compositor/gl/gl_compositor.hpp"
 #include "hmz_output/packing.hpp"
 #include "hmz_output/window_display.hpp"
+#include "inputs/source_drivers.hpp"
 #include "player/player.hpp"
 #include "support/media.hpp"
 #include "support/test_support.hpp"
