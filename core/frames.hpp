@@ -5,7 +5,10 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
+
+#include "core/image.hpp"
 
 namespace nelf {
 
@@ -36,6 +39,9 @@ struct StereoVideoFrame {
   double aspect = 0.0;
   double pts_s = 0.0;              // time from the source's origin: from 0 at the start (or the requested start)
   std::array<int, 2> block{1, 1};  // ViewFormat::block of this frame
+  // The same two views at the source's own precision, when it has them as float (a still): what
+  // `nelf convert` composes a still from, so that its output never goes through `bits`.
+  std::shared_ptr<const StereoPair> exact_views;
 };
 
 inline std::size_t bytes_per_pixel(int bits) { return bits > 8 ? 8 : 4; }

@@ -35,7 +35,8 @@ class SyntheticFrameSource final : public Source {
                        to_rgba8(pair.right.image),
                        pair.left.aspect(),
                        static_cast<double>(next_ - first_) / clip_.settings().fps,
-                       {1, 1}};
+                       {1, 1},
+                       nullptr};
     ++next_;
     return f;
   }

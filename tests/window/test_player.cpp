@@ -23,6 +23,7 @@
 #include "hmz_output/window_display.hpp"
 #include "inputs/source_drivers.hpp"
 #include "player/player.hpp"
+#include "support/image_files.hpp"
 #include "support/media.hpp"
 #include "support/test_support.hpp"
 #include "support/x11_window.hpp"
@@ -186,6 +187,49 @@ TEST_F(PlayerWindowTest, ClosingTheWindowEndsPlaybackCleanly) {
   const PlayResult result = play(*display, *source, options);
   EXPECT_EQ(result.end, PlayEnd::window_closed);
   EXPECT_EQ(result.counters.shown, 3);
+}
+
+// A stereo photo plays as its one frame, read as convert reads it (the still driver): a JPS (right
+// view first) and an MPO (two JPEGs) both show the left view to the left eye.
+TEST_F(PlayerWindowTest, AStereoPhotoShowsEachEyesView) {
+  const Image red = test::filled_image(320, 180, {0.75f, 0.2f, 0.1f, 1.f});
+  const Image blue = test::filled_image(320, 180, {0.1f, 0.25f, 0.75f, 1.f});
+  Image jps(640, 180);
+  for (int y = 0; y < 180; ++y)
+    for (int x = 0; x < 320; ++x) {
+      jps.at(x, y) = blue.at(x, y);
+      jps.at(320 + x, y) = red.at(x, y);
+    }
+  test::write_test_image(dir_ / "photo.jps", jps, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  test::write_test_image(dir_ / "l.jpg", red, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  test::write_test_image(dir_ / "r.jpg", blue, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  test::write_file(dir_ / "camera.mpo", test::read_file(dir_ / "l.jpg") + test::read_file(dir_ / "r.jpg"));
+
+  PlayerOptions options = silent_options();
+  auto display = open_display(options);
+  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
+  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
+  for (const char* name : {"photo.jps", "camera.mpo"}) {
+    SCOPED_TRACE(name);
+    std::vector<std::pair<Mean, Mean>> seen;
+    options.after_render = [&](const Display& d, double pts) {
+      EXPECT_EQ(pts, 0.0);
+      const auto panel = [&](const EyeArea& a) {
+        return mean_of(
+            read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90));
+      };
+      seen.emplace_back(panel(left), panel(right));
+    };
+    auto source =
+        open_source(SourceRequest{(dir_ / name).string(), "", std::nullopt, false, std::nullopt, true, false});
+    EXPECT_NE(source->info().description.find("still image"), std::string::npos) << source->info().description;
+    const PlayResult result = play(*display, *source, options);
+    EXPECT_EQ(result.end, PlayEnd::end_of_file);
+    EXPECT_EQ(result.counters.shown, 1);
+    ASSERT_EQ(seen.size(), 1u);
+    EXPECT_GT(seen[0].first.r, seen[0].first.b + 0.2);
+    EXPECT_GT(seen[0].second.b, seen[0].second.r + 0.2);
+  }
 }
 
 // A source that records the block of each frame it hands out; with `allow_reduction` false it
