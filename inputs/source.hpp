@@ -1,8 +1,8 @@
 #pragma once
 // A Source: stereo frames from an input, split into the two views the way the layout says: a media
 // file in any layout (sbs, tab, fp, mono …, `alt` frame-sequential, `pair` = a second file for the
-// right view) or the built-in `synthetic:` clip. Shared by `nelf convert` (video) and `nelf play`,
-// so that both honour --layout, --right and --swap-eyes identically.
+// right view), a still (JPS, MPO, an image pair) or the built-in `synthetic:` clip. Shared by
+// `nelf convert` and `nelf play`, so that both honour --layout, --right and --swap-eyes identically.
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -16,8 +16,9 @@
 
 namespace nelf {
 
+// What to open; the driver table (inputs/source_drivers.hpp) picks the driver that reads it.
 struct SourceRequest {
-  std::string input;                   // a media file or `synthetic:[options]`
+  std::string input;                   // a media file, a still image or `synthetic:[options]`
   std::string right;                   // second input for layout pair
   std::optional<StereoLayout> layout;  // nullopt: detect
   bool swap_eyes = false;
@@ -26,7 +27,6 @@ struct SourceRequest {
   bool allow_network = false;                   // FFmpeg protocols beyond file and pipe
   std::int64_t max_pixels = kDefaultMaxPixels;  // --max-pixels: larger frames are refused undecoded
 };
-// Opened by the driver table: inputs/source_drivers.hpp.
 
 // What a source says about its stream once it is open.
 struct SourceInfo {
