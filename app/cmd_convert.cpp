@@ -18,9 +18,8 @@
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
 #include "hmz_output/signal.hpp"
+#include "inputs/source_drivers.hpp"
 #include "inputs/stereo_layout.hpp"
-#include "inputs/still_source.hpp"
-#include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "optics/profile.hpp"
 #include "player/convert_video.hpp"
@@ -41,21 +40,19 @@ struct ConvertArgs : CommonArgs {
   bool no_audio = false, quiet = false, strict = false;
 };
 
-// Still images go through OpenImageIO; everything else (and `synthetic:`) is video.
-bool is_still_image(const std::string& path) {
-  if (is_synthetic_spec(path)) return false;
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  static const std::vector<std::string> still = {".png", ".jpg",  ".jpeg", ".jps", ".mpo", ".tif", ".tiff", ".exr",
-                                                 ".bmp", ".webp", ".tga",  ".ppm", ".pnm", ".hdr", ".dpx"};
-  return std::find(still.begin(), still.end(), ext) != still.end();
+// Inputs the still driver reads (OpenImageIO) become one image; everything else (and `synthetic:`)
+// is video.
+bool is_still_image(const std::string& input) {
+  SourceRequest request;
+  request.input = input;
+  return source_driver_for(request).name == "still";
 }
 
 // Everything that can be checked without reading the input, checked before any work.
 struct ConvertPlan {
   Profile profile;
   Signal signal;
-  StillOptions still;
+  SourceRequest still;
   CompositorOptions compositor;
   ImageWriteOptions write;
 };
@@ -63,10 +60,12 @@ struct ConvertPlan {
 ConvertPlan plan_convert(const ConvertArgs& args) {
   ConvertPlan plan;
   CommonOptions common = parse_common_options(args, true);
+  plan.still.input = args.input;
+  plan.still.right = args.right;
   plan.still.layout = common.layout;
-  if (!args.right.empty()) plan.still.right = args.right;
   plan.still.swap_eyes = args.swap_eyes;
   plan.still.max_pixels = args.max_pixels;
+  plan.still.quiet = true;  // a still is converted without a line about it (warnings are printed)
   plan.compositor = common.compositor;
   plan.profile = std::move(common.profile);
   plan.signal = common.signal;
@@ -185,16 +184,12 @@ void run_convert(const ConvertArgs& args) {
   if (!is_still_image(args.input)) return run_convert_video(args, inputs);
   if (is_raw_output(args.output)) refuse_options_raw_cannot_apply(args);
   const ConvertPlan plan = plan_convert(args);
-  StillStereo still;
-  try {
-    still = load_still(args.input, plan.still);
-  } catch (const StillError& e) {
-    throw UserError(e.what(), 1);
-  }
-  if (!still.decision.warning.empty()) fmt::print(stderr, "nelf: warning: {}\n", printable(still.decision.warning));
-
-  if (is_raw_output(args.output)) return write_packed_still_raw(still.views, plan);
-  write_packed_still(still.views, plan.profile, plan.signal, plan.compositor, args.output, plan.write);
+  // Read as play reads it (the still driver); composed from its float views, not the frame's bytes.
+  const std::optional<StereoVideoFrame> frame = open_source(plan.still)->next();
+  if (!frame || !frame->exact_views) throw std::logic_error("the still driver gave no views of " + args.input);
+  const StereoPair& views = *frame->exact_views;
+  if (is_raw_output(args.output)) return write_packed_still_raw(views, plan);
+  write_packed_still(views, plan.profile, plan.signal, plan.compositor, args.output, plan.write);
 }
 
 }  // namespace

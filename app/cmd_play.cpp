@@ -10,7 +10,7 @@
 #include "core/printable.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/display_drivers.hpp"
-#include "inputs/stereo_frame_source.hpp"
+#include "inputs/source_drivers.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/video_source.hpp"
 #include "player/interrupt.hpp"
@@ -44,7 +44,7 @@ void run_play(const PlayArgs& args) {
   if (!args.connector.empty() && args.output != "kms")
     throw UserError("--connector chooses the HDMI connector for --output kms", 2);
 
-  StereoSourceRequest request;
+  SourceRequest request;
   request.input = args.input;
   request.right = args.right;
   request.layout = args.right.empty() ? common.layout : StereoLayout::pair;
@@ -52,7 +52,7 @@ void run_play(const PlayArgs& args) {
   request.quiet = args.quiet;
   request.allow_network = args.allow_network;
   request.max_pixels = args.max_pixels;
-  const auto source = open_stereo_frame_source(request);
+  const auto source = open_source(request);
 
   PlayerOptions options;
   options.profile = common.profile;

@@ -86,12 +86,12 @@ void FrameCompositor::update_wanted_blocks() {
         views_.width > 0 ? wanted_block(eye, views_.width, views_.height, views_.aspect) : std::array<int, 2>{1, 1};
 }
 
-void FrameCompositor::prepare_views(const ViewGeometry& views) {
+void FrameCompositor::prepare_views(const FrameViews& views) {
   open_views(views);
   if (!use_tables()) start_gl();
 }
 
-void FrameCompositor::open_views(const ViewGeometry& views) {
+void FrameCompositor::open_views(const FrameViews& views) {
   if (views == views_) return;
   views_ = views;
   view_textures_ = {};

@@ -39,12 +39,13 @@ struct FrameOverlays {
   bool swap_eyes = false;         // eye e shows view e ^ 1
 };
 
-// The views a stream's frames have (StereoVideoFrame's width, height, bits, aspect and block).
-struct ViewGeometry {
+// The views a stream's frames have as the compositor takes them (StereoVideoFrame's width, height,
+// bits, aspect and block): what its textures and tables are made for.
+struct FrameViews {
   int width = 0, height = 0, bits = 8;
   double aspect = 0.0;
   std::array<int, 2> block{1, 1};
-  bool operator==(const ViewGeometry&) const = default;
+  bool operator==(const FrameViews&) const = default;
 };
 
 // Which frames the CPU composite tables may composite, where prefer_composite_table says they pay
@@ -83,6 +84,12 @@ class FrameCompositor {
   std::array<int, 2> wanted_block(Eye eye, int width, int height, double aspect) const;
   // The block both eyes take, or {1, 1} when they differ: what a stereo source is asked for.
   std::array<int, 2> wanted_block(int width, int height, double aspect) const;
+  // The same as the view format a source of `view`s negotiates (Source::negotiate): views as the
+  // prefilter's block means where the input allows (swscale makes them while converting from
+  // YUV), far less to convert, upload and composite per frame. It follows the optics.
+  ViewFormat wanted_view_format(const ViewGeometry& view) const {
+    return {wanted_block(view.width, view.height, view.aspect)};
+  }
 
   // New optics (the live keys). Throws, keeping the current profile, when `profile` is not
   // usable (or has another panel than the layout's).
@@ -95,7 +102,7 @@ class FrameCompositor {
   // Chooses between GL and the composite tables for frames of `views` now (loading tables from
   // the cache, starting GL, recording tables) rather than at the first frame: a conversion fails
   // before it opens its output.
-  void prepare_views(const ViewGeometry& views);
+  void prepare_views(const FrameViews& views);
   // `frame` (with the grid when overlays.calibration_grid) made ready for render(): done by
   // render() itself, and only once per frame; separately it can be timed, and a grid that cannot
   // be made throws here (std::runtime_error) rather than there.
@@ -124,7 +131,7 @@ class FrameCompositor {
   void start_gl();
   void rebuild_gl();
   TextOverlay& text_overlay();
-  void open_views(const ViewGeometry& views);
+  void open_views(const FrameViews& views);
   bool reduced() const { return views_.block[0] > 1 || views_.block[1] > 1; }
   int texture_w() const { return views_.width / views_.block[0]; }
   int texture_h() const { return views_.height / views_.block[1]; }
@@ -155,16 +162,16 @@ class FrameCompositor {
   GridPattern grid_pattern_;
   int profile_generation_ = 0;  // what the grid was made for changes with it
 
-  // The views of the frames (ViewGeometry), the blocks the prefilter wants for them, and their
+  // The views of the frames (FrameViews), the blocks the prefilter wants for them, and their
   // textures (GL), filled from the last prepared frame when the GL path first needs them.
-  ViewGeometry views_;
+  FrameViews views_;
   std::array<std::array<int, 2>, 2> wanted_blocks_{};
   std::array<gl::Texture, 2> view_textures_;
   bool textures_current_ = false;
   // The calibration cover per view and what it was made for, and the views with it drawn over.
   std::shared_ptr<const std::array<Image, 2>> grid_;
   int grid_generation_ = -1;
-  ViewGeometry grid_views_made_for_;
+  FrameViews grid_views_made_for_;
   std::array<std::vector<std::uint8_t>, 2> grid_views_;
   // The message as a cover for the views' bytes (CPU path), what it was made for, and the views
   // with it drawn over them.

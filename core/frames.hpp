@@ -5,21 +5,43 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "core/image.hpp"
+
 namespace nelf {
+
+// The views of a stream as its source has them: the full size of each view and the aspect it is
+// displayed at. What a consumer sizes the view format it asks for from (Source::negotiate).
+struct ViewGeometry {
+  int width = 0, height = 0;
+  double aspect = 0.0;
+  bool operator==(const ViewGeometry&) const = default;
+};
+
+// How the views of a stream travel: each delivered pixel the mean of block[0]×block[1] pixels of
+// the view ({1, 1}: whole views). Asked for once per stream, and again when the optics change;
+// every frame carries the format it was made in (StereoVideoFrame::block).
+struct ViewFormat {
+  std::array<int, 2> block{1, 1};
+  bool operator==(const ViewFormat&) const = default;
+};
 
 // Both views of one stereo frame, as tightly packed RGBA of `bits` per channel (8: one byte per
 // channel; 16: native-endian uint16 per channel): width×height pixels, or, when `block` is more
 // than 1×1, (width / block[0])×(height / block[1]) means of block[0]×block[1] pixels each (made
-// while converting from YUV, see StereoFrameSource::reduce_views). width, height and aspect are
+// while converting from YUV, in the ViewFormat the source negotiated). width, height and aspect are
 // always those of the full view.
 struct StereoVideoFrame {
   int width = 0, height = 0, bits = 8;
   std::vector<std::uint8_t> left, right;
   double aspect = 0.0;
-  double pts_s = 0.0;  // time from the source's origin: from 0 at the start (or the requested start)
-  std::array<int, 2> block{1, 1};
+  double pts_s = 0.0;              // time from the source's origin: from 0 at the start (or the requested start)
+  std::array<int, 2> block{1, 1};  // ViewFormat::block of this frame
+  // The same two views at the source's own precision, when it has them as float (a still): what
+  // `nelf convert` composes a still from, so that its output never goes through `bits`.
+  std::shared_ptr<const StereoPair> exact_views;
 };
 
 inline std::size_t bytes_per_pixel(int bits) { return bits > 8 ? 8 : 4; }

@@ -2,7 +2,7 @@
 // A media file's audio as an AudioStream: the default audio stream, decoded with libavcodec and
 // resampled with libswresample to interleaved float (stereo unless asked otherwise) at the
 // output's rate, each chunk stamped with its presentation time on the video's timeline (seconds
-// from the same origin as StereoFrameSource::pts_s). Damaged packets are skipped and counted, as
+// from the same origin as StereoVideoFrame::pts_s). Damaged packets are skipped and counted, as
 // for video.
 #include <cstdint>
 #include <memory>

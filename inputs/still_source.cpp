@@ -264,6 +264,12 @@ Image read_image_file(const fs::path& path, std::int64_t max_pixels) {
   }
 }
 
+bool is_still_image_name(const std::string& input) {
+  static const std::vector<std::string> still = {".png", ".jpg",  ".jpeg", ".jps", ".mpo", ".tif", ".tiff", ".exr",
+                                                 ".bmp", ".webp", ".tga",  ".ppm", ".pnm", ".hdr", ".dpx"};
+  return std::find(still.begin(), still.end(), lowercase_extension(input)) != still.end();
+}
+
 StillStereo load_still(const fs::path& path, const StillOptions& options) {
   if (options.right) {
     if (options.layout && *options.layout != StereoLayout::pair)

@@ -45,6 +45,10 @@ std::vector<std::size_t> find_jpeg_images(std::span<const std::byte> bytes);
 // that is present and points at JPEG images, else from find_jpeg_images.
 std::vector<std::size_t> find_mpo_images(std::span<const std::byte> bytes);
 
+// Whether `input` names a still image by its extension (.png, .jpg, .jps, .mpo, .tif, .exr, …, any
+// case): those are read here, everything else as video.
+bool is_still_image_name(const std::string& input);
+
 struct StillOptions {
   std::optional<StereoLayout> layout;           // --layout; nothing = detect
   std::optional<std::filesystem::path> right;   // --right: the right view is a second file

@@ -366,6 +366,8 @@ struct VideoSource::Impl {
     if (stream->start_time != AV_NOPTS_VALUE)
       info.start_time_s = static_cast<double>(stream->start_time) * av_q2d(stream->time_base);
     if (stream->nb_frames > 0) info.frame_count = stream->nb_frames;
+    // A pipe cannot go back; image2 and other demuxers without their own I/O seek by reopening.
+    info.seekable = !format->pb || (format->pb->seekable & AVIO_SEEKABLE_NORMAL) != 0;
 
     const auto pixel_format = static_cast<AVPixelFormat>(par.format);
     if (const char* name = av_get_pix_fmt_name(pixel_format)) info.pixel_format = name;

@@ -53,6 +53,7 @@ struct VideoInfo {
   std::optional<double> duration_s;
   double start_time_s = 0.0;                // pts of the first frame, as the container says
   std::optional<std::int64_t> frame_count;  // from the container's index, when it has one
+  bool seekable = true;                     // false for a pipe: seek() then fails
   int audio_streams = 0;
   int bits_per_component = 8;  // of the source (8, 10, 12, 16); delivered frames use 8 or 16
   ColorMatrix matrix = ColorMatrix::bt709;

@@ -28,7 +28,7 @@ extern "C" {
 #include "hmz_output/frame_sink.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
-#include "inputs/stereo_frame_source.hpp"
+#include "inputs/source_drivers.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
@@ -231,7 +231,7 @@ class FirstError {
 // What a sink is opened with, once the packed frame's size is known.
 struct FrameSinkContext {
   const VideoConvertRequest& request;
-  StereoFrameSource& source;
+  Source& source;
   int width, height, bits;
 };
 
@@ -246,7 +246,7 @@ struct FrameSinkDriver {
 constexpr FrameSinkDriver kFrameSinks[] = {
     {"raw", is_raw_output,
      [](const FrameSinkContext& c) {
-       return open_raw_frame_sink(STDOUT_FILENO, c.width, c.height, c.source.frame_rate());
+       return open_raw_frame_sink(STDOUT_FILENO, c.width, c.height, c.source.info().frame_rate);
      }},
     {"image", [](const std::string& o) { return is_image_sequence_pattern(o) || is_image_file_name(o); },
      [](const FrameSinkContext& c) -> std::unique_ptr<FrameSink> {
@@ -261,7 +261,7 @@ constexpr FrameSinkDriver kFrameSinks[] = {
          if (!carried) audio = c.source.open_audio({}).stream;
        }
        return std::make_unique<EncodedFileSink>(c.request, std::move(carried), std::move(audio), c.width, c.height,
-                                                c.bits, c.source.frame_rate());
+                                                c.bits, c.source.info().frame_rate);
      }},
 };
 
@@ -282,13 +282,11 @@ bool is_image_sequence_pattern(const std::string& output) {
 
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
+  std::unique_ptr<Source> source = open_source(
+      SourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels});
   // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
-  std::unique_ptr<StereoFrameSource> source = open_stereo_frame_source(
-      StereoSourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network,
-                          [&r](int width, int height, double aspect) {
-                            return stereo_prefilter_block(r.profile, r.compositor, width, height, aspect);
-                          },
-                          r.max_pixels});
+  const ViewGeometry view = source->info().view;
+  source->negotiate({stereo_prefilter_block(r.profile, r.compositor, view.width, view.height, view.aspect)});
 
   // The first frame fixes the view size and depth for the whole run.
   auto first = source->next();
@@ -297,9 +295,9 @@ void convert_video(const VideoConvertRequest& r) {
   const double aspect = first->aspect;
   const std::array<int, 2> block = first->block;
 
-  std::optional<long> total = source->expected_frames();
+  std::optional<long> total = source->info().expected_frames;
   if (r.duration_s && total)
-    total = std::min(*total, static_cast<long>(std::lround(*r.duration_s * source->frame_rate())));
+    total = std::min(*total, static_cast<long>(std::lround(*r.duration_s * source->info().frame_rate)));
   if (r.max_frames) total = total ? std::min(*total, *r.max_frames) : *r.max_frames;
 
   BoundedQueue<StereoVideoFrame> decoded(4);

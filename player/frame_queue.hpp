@@ -11,7 +11,7 @@
 
 #include "compositor/cpu/composite_ahead.hpp"
 #include "core/frames.hpp"
-#include "inputs/stereo_frame_source.hpp"
+#include "inputs/source.hpp"
 
 namespace nelf::playback {
 
@@ -25,18 +25,18 @@ class FrameQueue {
 
   explicit FrameQueue(std::size_t capacity) : capacity_(capacity) {}
 
-  // Decode thread: waits for room (or a seek, a new reduction, or stop). Returns the seek target
-  // and the reduction if one is pending.
+  // Decode thread: waits for room (or a seek, a new view format, or stop). Returns the seek target
+  // and the view format if one is pending.
   struct Work {
     std::optional<double> seek_to;
-    std::optional<ViewBlockChooser> reduce;
+    std::optional<ViewFormat> view_format;
     std::uint64_t generation = 0;
     bool stop = false;
   };
   Work wait_for_work() {
     std::unique_lock lock(mutex_);
-    changed_.wait(lock, [&] { return stop_ || seek_to_ || reduce_ || (!end_ && items_.size() < capacity_); });
-    Work work{std::exchange(seek_to_, std::nullopt), std::exchange(reduce_, std::nullopt), generation_, stop_};
+    changed_.wait(lock, [&] { return stop_ || seek_to_ || view_format_ || (!end_ && items_.size() < capacity_); });
+    Work work{std::exchange(seek_to_, std::nullopt), std::exchange(view_format_, std::nullopt), generation_, stop_};
     return work;
   }
   void push(StereoVideoFrame frame, std::uint64_t generation) {
@@ -66,11 +66,11 @@ class FrameQueue {
     end_ = false;
     changed_.notify_all();
   }
-  // The views of frames decoded from now on as `choose` says (StereoFrameSource::reduce_views);
-  // frames already queued keep theirs.
-  void reduce_views(ViewBlockChooser choose) {
+  // The views of frames decoded from now on in `wanted` format where the source allows it
+  // (Source::negotiate, on the decode thread); frames already queued keep theirs.
+  void negotiate(ViewFormat wanted) {
     std::lock_guard lock(mutex_);
-    reduce_ = std::move(choose);
+    view_format_ = wanted;
     changed_.notify_all();
   }
   void stop() {
@@ -120,7 +120,7 @@ class FrameQueue {
   std::deque<Frame> items_;
   std::size_t capacity_;
   std::optional<double> seek_to_;
-  std::optional<ViewBlockChooser> reduce_;
+  std::optional<ViewFormat> view_format_;
   std::uint64_t generation_ = 0;
   bool end_ = false, stop_ = false;
   std::exception_ptr error_;
@@ -130,12 +130,12 @@ class FrameQueue {
 // dropped by the scheduler. (Skipping late frames here as well was measured and is worse when
 // decoding is the bottleneck: each decoded frame is late, so most were thrown away without the
 // decoder catching up; jumping ahead by seeking is worse still with long GOPs.)
-inline void decode_loop(StereoFrameSource& source, FrameQueue& queue) {
+inline void decode_loop(Source& source, FrameQueue& queue) {
   try {
     for (;;) {
       const FrameQueue::Work work = queue.wait_for_work();
       if (work.stop) return;
-      if (work.reduce) source.reduce_views(*work.reduce);
+      if (work.view_format) source.negotiate(*work.view_format);
       if (work.seek_to) {
         source.seek(*work.seek_to);
         continue;

@@ -11,12 +11,6 @@
 
 namespace nelf::playback {
 
-ViewBlockChooser view_blocks_for(const Profile& profile, const CompositorOptions& compositor) {
-  return [profile, compositor](int width, int height, double aspect) {
-    return stereo_prefilter_block(profile, compositor, width, height, aspect);
-  };
-}
-
 FrameCompositor::GridPattern calibration_grid_pattern() {
   return [](const Profile& profile, int width, int height) {
     StereoPair pair = make_test_pattern(TestPattern::grid, pattern_geometry(profile, width, height));
@@ -55,7 +49,7 @@ void PlayCommands::seek_by(double delta) {
 void PlayCommands::change_profile(const Profile& changed, const std::string& what) {
   try {
     compositor_.set_profile(changed);
-    queue_.reduce_views(view_blocks_for(changed, options_.compositor));
+    queue_.negotiate(compositor_.wanted_view_format(view_));
     state_.dirty = true;
     say(what);
   } catch (const std::exception& e) {

@@ -12,7 +12,7 @@
 #include "compositor/frame_compositor.hpp"
 #include "core/frames.hpp"
 #include "hmz_output/display.hpp"
-#include "inputs/stereo_frame_source.hpp"
+#include "inputs/source.hpp"
 #include "optics/profile.hpp"
 #include "player/frame_queue.hpp"
 #include "player/frame_scheduler.hpp"
@@ -20,11 +20,6 @@
 #include "player/play_sound.hpp"
 
 namespace nelf::playback {
-
-// Views as the prefilter's block means where the input allows (swscale makes them while
-// converting from YUV): far less to convert, upload and composite per frame. The block follows
-// the optics.
-ViewBlockChooser view_blocks_for(const Profile& profile, const CompositorOptions& compositor);
 
 // The calibration grid (key c): calibrate's grid pattern at the views' size and the optics.
 FrameCompositor::GridPattern calibration_grid_pattern();
@@ -43,7 +38,8 @@ struct PlayState {
 class PlayCommands {
  public:
   PlayCommands(PlayState& state, Display& display, FrameCompositor& compositor, FrameQueue& queue, PlaySound& sound,
-               FrameScheduler& scheduler, const PlayerOptions& options, std::optional<double> duration_s)
+               FrameScheduler& scheduler, const PlayerOptions& options, std::optional<double> duration_s,
+               ViewGeometry view)
       : state_(state),
         display_(display),
         compositor_(compositor),
@@ -51,7 +47,8 @@ class PlayCommands {
         sound_(sound),
         scheduler_(scheduler),
         options_(options),
-        duration_s_(duration_s) {}
+        duration_s_(duration_s),
+        view_(view) {}
 
   // Carries out `command`; false for quit.
   bool apply(Command command);
@@ -74,6 +71,7 @@ class PlayCommands {
   FrameScheduler& scheduler_;
   const PlayerOptions& options_;
   std::optional<double> duration_s_;
+  ViewGeometry view_;          // the source's, for the view format a change of the optics asks for
   std::size_t help_line_ = 0;  // the next line of the key help that h shows
   std::string message_;
   std::chrono::steady_clock::time_point message_until_{};

@@ -6,7 +6,7 @@
 
 namespace nelf::playback {
 
-PlaySound::PlaySound(StereoFrameSource& source, const PlayerOptions& options) {
+PlaySound::PlaySound(Source& source, const PlayerOptions& options) {
   if (!options.audio) {
     description_ = "--no-audio";
     return;

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "hmz_output/audio_output.hpp"
-#include "inputs/stereo_frame_source.hpp"
+#include "inputs/source.hpp"
 #include "player/audio_feeder.hpp"
 #include "player/player.hpp"
 
@@ -16,7 +16,7 @@ class PlaySound {
  public:
   // Opens the source's audio on the default device unless options.audio is off or there is none
   // to play; failures (no stream, undecodable, no device) become the reason, never an error.
-  PlaySound(StereoFrameSource& source, const PlayerOptions& options);
+  PlaySound(Source& source, const PlayerOptions& options);
 
   PlaybackClock& clock() { return audio_ ? static_cast<PlaybackClock&>(*audio_) : system_clock_; }
   bool playing() const { return audio_ != nullptr; }

@@ -40,7 +40,6 @@ using playback::PlaySound;
 using playback::PlayState;
 using playback::RefreshTicker;
 using playback::RenderTime;
-using playback::view_blocks_for;
 
 }  // namespace
 
@@ -52,8 +51,7 @@ std::string play_summary(const PlayResult& r) {
   return line;
 }
 
-PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions& options,
-                const std::atomic<bool>* stop) {
+PlayResult play(Display& display, Source& source, const PlayerOptions& options, const std::atomic<bool>* stop) {
   PlayResult result;
   // The on-screen messages draw their text with OpenImageIO, loaded on first use: load it now
   // (~0.3 s) rather than as a hitch at the first key press. Without it the film still plays; the
@@ -88,9 +86,10 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   clock.set_paused(true);
 
   const double refresh_period = 1.0 / display.refresh_hz();
-  const double fps = source.frame_rate();
+  const SourceInfo info = source.info();
+  const double fps = info.frame_rate;
   FrameScheduler scheduler(refresh_period, fps > 0 ? 1.0 / fps : 0.0);
-  source.reduce_views(view_blocks_for(options.profile, options.compositor));
+  source.negotiate(compositor.wanted_view_format(info.view));
   constexpr std::size_t queue_capacity = 6;
   FrameQueue queue(queue_capacity);
   std::jthread decoder([&] { decode_loop(source, queue); });
@@ -100,7 +99,7 @@ PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions
   } stop_decoder{queue};
 
   PlayState state;
-  PlayCommands commands(state, display, compositor, queue, sound, scheduler, options, source.duration_s());
+  PlayCommands commands(state, display, compositor, queue, sound, scheduler, options, info.duration_s, info.view);
   RenderTime render_time(refresh_period);  // the first render, which compiles shaders, does not count
   RefreshTicker ticker(refresh_period);
   std::int64_t refresh = 0;

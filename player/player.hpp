@@ -14,7 +14,7 @@
 #include "compositor/compositor.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/signal.hpp"
-#include "inputs/stereo_frame_source.hpp"
+#include "inputs/source.hpp"
 #include "optics/profile.hpp"
 #include "player/frame_scheduler.hpp"
 
@@ -52,7 +52,7 @@ struct PlayResult {
 // Plays `source` on `display` until the end of the file, q/Esc, the window closing or `*stop`
 // becoming true (SIGINT/SIGTERM). Must be called on the display's thread. Throws UserError for
 // unusable input or outputs (the panel does not fit the signal, the display is lost).
-PlayResult play(Display& display, StereoFrameSource& source, const PlayerOptions& options,
+PlayResult play(Display& display, Source& source, const PlayerOptions& options,
                 const std::atomic<bool>* stop = nullptr);
 
 // The one line printed at exit: "played 48 frames: 48 shown, 0 repeated, 0 dropped".

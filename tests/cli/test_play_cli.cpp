@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "support/image_files.hpp"
 #include "support/media.hpp"
 #include "support/test_support.hpp"
 #include "support/xvfb.hpp"
@@ -294,6 +295,48 @@ TEST(PlayCliErrors, BadInputsAsConvertSaysThem) {
       << output.err;
 }
 
+// A JPS (right view first) and an MPO (two JPEGs), written for the test.
+void write_stereo_photos(const TempDir& dir) {
+  const Image red = filled_image(32, 18, {0.75f, 0.2f, 0.1f, 1.f}),
+              blue = filled_image(32, 18, {0.1f, 0.25f, 0.75f, 1.f});
+  Image jps(64, 18);
+  for (int y = 0; y < 18; ++y)
+    for (int x = 0; x < 32; ++x) {
+      jps.at(x, y) = blue.at(x, y);
+      jps.at(32 + x, y) = red.at(x, y);
+    }
+  write_test_image(dir / "photo.jps", jps, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  write_test_image(dir / "l.jpg", red, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  write_test_image(dir / "r.jpg", blue, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  write_file(dir / "camera.mpo", read_file(dir / "l.jpg") + read_file(dir / "r.jpg"));
+}
+
+// A still's problems, read by the still driver in play as in convert: the same one line and status.
+TEST(PlayCliErrors, AStillsProblemsAsConvertSaysThem) {
+  TempDir dir;
+  write_stereo_photos(dir);
+  write_file(dir / "one.mpo", read_file(dir / "l.jpg"));
+  write_file(dir / "cut.jpg", read_file(dir / "l.jpg").substr(0, 40));
+  const std::vector<std::string> cases = {
+      q(dir / "missing.jps"),
+      q(dir / "one.mpo"),
+      q(dir / "cut.jpg"),
+      q(dir / "photo.jps") + " --layout alt",
+      q(dir / "camera.mpo") + " --layout sbs",
+  };
+  for (const auto& args : cases) {
+    SCOPED_TRACE(args);
+    const auto play = run_command("env -u DISPLAY " + std::string(NELF_BINARY) + " play " + args);
+    const auto convert = run_nelf("convert " + args.substr(0, args.find(' ')) + " " + q(dir / "out.png") +
+                                  (args.find(' ') == std::string::npos ? "" : args.substr(args.find(' '))));
+    EXPECT_NE(play.status, 0);
+    EXPECT_EQ(play.status, convert.status) << play.err << convert.err;
+    EXPECT_EQ(play.err, convert.err);
+    EXPECT_EQ(std::count(play.err.begin(), play.err.end(), '\n'), 1) << play.err;
+    EXPECT_EQ(play.err.rfind("nelf: ", 0), 0u) << play.err;
+  }
+}
+
 // --gpu picks the EGL device headless rendering uses; play renders on its display's own GPU, so the
 // option would be ignored: it is refused instead, before anything opens.
 TEST(PlayCliErrors, GpuIsRefusedAsItCannotApply) {
@@ -335,6 +378,25 @@ TEST(PlayOffscreen, PlaysWithoutADisplayServerAndPrintsTheSummary) {
   ASSERT_FALSE(rows.empty());
   EXPECT_GT(rows.back().clock, 1.9);  // paced by the clock: the clip's time, not as fast as it renders
   EXPECT_GT(std::chrono::steady_clock::now() - started, std::chrono::seconds(2));
+}
+
+// A stereo photo plays off screen as its one frame, read by the still driver (OpenImageIO), for the
+// frame period a still always had in play.
+TEST(PlayOffscreen, PlaysAJpsAndAnMpoAsTheirOneFrame) {
+  TempDir dir;
+  write_stereo_photos(dir);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"photo.jps", "photo.jps: still image, two 32x18 views, layout sbs swapped (filename)\n"},
+      {"camera.mpo", "camera.mpo: still image, two 32x18 views, layout pair (metadata)\n"},
+  };
+  for (const auto& [name, described] : cases) {
+    SCOPED_TRACE(name);
+    const auto r = run_command("env -u DISPLAY LP_NUM_THREADS=2 " + std::string(NELF_BINARY) + " play " +
+                               q(dir / name) + " --output offscreen --no-audio");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find(described), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("nelf: 1 frames shown, 0 repeated, 0 dropped\n"), std::string::npos) << r.err;
+  }
 }
 
 // --gpu applies off screen (headless rendering), and a device EGL does not list is refused.

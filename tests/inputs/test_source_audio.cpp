@@ -10,7 +10,7 @@
 
 #include "inputs/audio_source.hpp"
 #include "inputs/file_carried_streams.hpp"
-#include "inputs/stereo_frame_source.hpp"
+#include "inputs/source_drivers.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "player/play_sound.hpp"
@@ -29,8 +29,8 @@ class SourceAudioTest : public ::testing::Test {
   TempDir dir;
 };
 
-StereoSourceRequest request_for(const std::string& input, std::optional<double> start_s = std::nullopt) {
-  return StereoSourceRequest{input, "", StereoLayout::sbs, false, start_s, true, false, {}};
+SourceRequest request_for(const std::string& input, std::optional<double> start_s = std::nullopt) {
+  return SourceRequest{input, "", StereoLayout::sbs, false, start_s, true, false, kDefaultMaxPixels};
 }
 
 // Red and blue views side by side at 10 fps for 2 s, with a tone unless `audio` is false.
@@ -53,7 +53,7 @@ std::vector<AudioChunk> collect(AudioStream& stream) {
 
 TEST_F(SourceAudioTest, AFilesAudioIsAudioSourcesOnTheFirstFrameDelivered) {
   const auto clip = make_clip(dir);
-  auto source = open_stereo_frame_source(request_for(clip, 0.5));
+  auto source = open_source(request_for(clip, 0.5));
   ASSERT_NEAR(source->next()->pts_s, 0.0, 1e-9);
   auto opened = source->open_audio({44100, 2});
   ASSERT_TRUE(opened.stream) << opened.why_not;
@@ -73,14 +73,14 @@ TEST_F(SourceAudioTest, AFilesAudioIsAudioSourcesOnTheFirstFrameDelivered) {
 }
 
 TEST_F(SourceAudioTest, AFileWithoutSoundSaysSo) {
-  auto source = open_stereo_frame_source(request_for(make_clip(dir, false)));
+  auto source = open_source(request_for(make_clip(dir, false)));
   const auto opened = source->open_audio({});
   EXPECT_FALSE(opened.stream);
   EXPECT_EQ(opened.why_not, "no audio stream");
 }
 
 TEST_F(SourceAudioTest, TheSyntheticClipsSoundIsItsToneFromTheStartAsked) {
-  auto source = open_stereo_frame_source(request_for("synthetic:duration=2,size=32x18", 1.0));
+  auto source = open_source(request_for("synthetic:duration=2,size=32x18", 1.0));
   auto opened = source->open_audio({});
   ASSERT_TRUE(opened.stream) << opened.why_not;
   EXPECT_EQ(opened.stream->sample_rate(), 48000);
@@ -95,7 +95,7 @@ TEST_F(SourceAudioTest, TheSyntheticClipsSoundIsItsToneFromTheStartAsked) {
 
 TEST_F(SourceAudioTest, AFileCarriesItsOwnStreamsFromTheFirstFrameDelivered) {
   const auto clip = make_clip(dir);
-  auto source = open_stereo_frame_source(request_for(clip, 0.5));
+  auto source = open_source(request_for(clip, 0.5));
   auto carried = source->open_carried_streams();
   ASSERT_TRUE(carried);
   ASSERT_EQ(carried->layout().streams.size(), 1u);
@@ -137,13 +137,13 @@ TEST_F(SourceAudioTest, PlayPlaysTheSyntheticClipsToneAndSaysWhyAFileHasNoSound)
   ScopedEnv driver("SDL_AUDIODRIVER", "dummy");
   PlayerOptions options;
   {
-    auto synthetic = open_stereo_frame_source(request_for("synthetic:duration=1,size=32x18"));
+    auto synthetic = open_source(request_for("synthetic:duration=1,size=32x18"));
     playback::PlaySound sound(*synthetic, options);
     EXPECT_TRUE(sound.playing()) << sound.description();
     EXPECT_EQ(sound.description().rfind("dummy, 48000 Hz", 0), 0u) << sound.description();
     sound.stop();
   }
-  auto silent = open_stereo_frame_source(request_for(make_clip(dir, false)));
+  auto silent = open_source(request_for(make_clip(dir, false)));
   playback::PlaySound none(*silent, options);
   EXPECT_FALSE(none.playing());
   EXPECT_EQ(none.description(), "no audio stream");

@@ -1,12 +1,14 @@
-// StereoFrameSource: views delivered as block means when the caller asks (reduce_views), across
-// seeks and changes of the block.
+// Source: views delivered as block means when the caller negotiates them, across seeks and
+// changes of the block.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
 
-#include "inputs/stereo_frame_source.hpp"
+#include "core/user_error.hpp"
+#include "inputs/source_drivers.hpp"
 #include "inputs/video_source.hpp"
 #include "support/media.hpp"
 #include "support/test_support.hpp"
@@ -30,8 +32,8 @@ double channel_mean(const std::vector<std::uint8_t>& rgba, int c) {
   return sum / static_cast<double>(rgba.size() / 4) / 255.0;
 }
 
-StereoSourceRequest request_for(const std::string& input, ViewBlockChooser choose) {
-  return StereoSourceRequest{input, "", StereoLayout::sbs, false, std::nullopt, true, false, std::move(choose)};
+SourceRequest request_for(const std::string& input) {
+  return SourceRequest{input, "", StereoLayout::sbs, false, std::nullopt, true, false};
 }
 
 // Red left view, blue right view, 64×36 each, 20 frames at 10 fps.
@@ -53,15 +55,12 @@ void expect_views(const StereoVideoFrame& f, std::array<int, 2> block) {
   EXPECT_LT(channel_mean(f.right, 0), 0.1);
 }
 
-TEST_F(StereoFrameSourceTest, DeliversTheRequestedBlockMeansFromTheFirstFrameOn) {
-  std::vector<std::array<double, 3>> asked;
-  auto source = open_stereo_frame_source(request_for(make_sbs_clip(dir), [&](int w, int h, double aspect) {
-    asked.push_back({static_cast<double>(w), static_cast<double>(h), aspect});
-    return std::array<int, 2>{4, 4};
-  }));
-  ASSERT_EQ(asked.size(), 1u);
-  EXPECT_EQ(asked[0][0], 64);  // the view, not the frame
-  EXPECT_EQ(asked[0][1], 36);
+TEST_F(StereoFrameSourceTest, DeliversTheNegotiatedBlockMeansFromTheFirstFrameOn) {
+  auto source = open_source(request_for(make_sbs_clip(dir)));
+  const ViewGeometry view = source->info().view;
+  EXPECT_EQ(view.width, 64);  // the view, not the frame
+  EXPECT_EQ(view.height, 36);
+  EXPECT_EQ(source->negotiate({{4, 4}}), (ViewFormat{{4, 4}}));
   const auto first = source->next();
   ASSERT_TRUE(first);
   expect_views(*first, {4, 4});
@@ -69,9 +68,8 @@ TEST_F(StereoFrameSourceTest, DeliversTheRequestedBlockMeansFromTheFirstFrameOn)
 }
 
 TEST_F(StereoFrameSourceTest, ASeekKeepsTheViewsReduced) {
-  auto source = open_stereo_frame_source(request_for(make_sbs_clip(dir), [](int, int, double) {
-    return std::array<int, 2>{2, 3};
-  }));
+  auto source = open_source(request_for(make_sbs_clip(dir)));
+  source->negotiate({{2, 3}});
   ASSERT_TRUE(source->next());
   ASSERT_TRUE(source->next());
   source->seek(1.0);
@@ -87,19 +85,16 @@ TEST_F(StereoFrameSourceTest, ASeekKeepsTheViewsReduced) {
 }
 
 TEST_F(StereoFrameSourceTest, TheBlockCanChangeMidStreamAndBackToWholeViews) {
-  auto source = open_stereo_frame_source(request_for(make_sbs_clip(dir), {}));
+  auto source = open_source(request_for(make_sbs_clip(dir)));
   const auto whole = source->next();
   ASSERT_TRUE(whole);
   expect_views(*whole, {1, 1});
-  EXPECT_EQ(source->reduce_views([](int, int, double) {
-    return std::array<int, 2>{4, 2};
-  }),
-            (std::array<int, 2>{4, 2}));
+  EXPECT_EQ(source->negotiate({{4, 2}}), (ViewFormat{{4, 2}}));
   const auto reduced = source->next();
   ASSERT_TRUE(reduced);
   EXPECT_NEAR(reduced->pts_s, 0.1, 1e-6);  // no frame lost or repeated by the change
   expect_views(*reduced, {4, 2});
-  EXPECT_EQ(source->reduce_views({}), (std::array<int, 2>{1, 1}));
+  EXPECT_EQ(source->negotiate({}), (ViewFormat{{1, 1}}));
   const auto back = source->next();
   ASSERT_TRUE(back);
   EXPECT_NEAR(back->pts_s, 0.2, 1e-6);
@@ -107,9 +102,8 @@ TEST_F(StereoFrameSourceTest, TheBlockCanChangeMidStreamAndBackToWholeViews) {
 }
 
 TEST_F(StereoFrameSourceTest, ABlockThatDoesNotDivideTheViewGivesWholeViews) {
-  auto source = open_stereo_frame_source(request_for(make_sbs_clip(dir), [](int, int, double) {
-    return std::array<int, 2>{5, 5};
-  }));
+  auto source = open_source(request_for(make_sbs_clip(dir)));
+  EXPECT_EQ(source->negotiate({{5, 5}}), (ViewFormat{{1, 1}}));
   const auto f = source->next();
   ASSERT_TRUE(f);
   expect_views(*f, {1, 1});
@@ -118,11 +112,8 @@ TEST_F(StereoFrameSourceTest, ABlockThatDoesNotDivideTheViewGivesWholeViews) {
 TEST_F(StereoFrameSourceTest, ChangingTheBlockBeforeTheFirstFrameReconvertsIt) {
   // The first frame is decoded while opening (layout detection); asking afterwards must not hand
   // it out at the old size.
-  auto source = open_stereo_frame_source(request_for(make_sbs_clip(dir), {}));
-  EXPECT_EQ(source->reduce_views([](int, int, double) {
-    return std::array<int, 2>{2, 2};
-  }),
-            (std::array<int, 2>{2, 2}));
+  auto source = open_source(request_for(make_sbs_clip(dir)));
+  EXPECT_EQ(source->negotiate({{2, 2}}), (ViewFormat{{2, 2}}));
   const auto first = source->next();
   ASSERT_TRUE(first);
   EXPECT_NEAR(first->pts_s, 0.0, 1e-6);
@@ -130,17 +121,64 @@ TEST_F(StereoFrameSourceTest, ChangingTheBlockBeforeTheFirstFrameReconvertsIt) {
 }
 
 TEST_F(StereoFrameSourceTest, SyntheticSourceAlwaysDeliversWholeViews) {
-  auto source = open_stereo_frame_source(request_for("synthetic:duration=1", [](int, int, double) {
-    return std::array<int, 2>{2, 2};
-  }));
-  EXPECT_EQ(source->reduce_views([](int, int, double) {
-    return std::array<int, 2>{2, 2};
-  }),
-            (std::array<int, 2>{1, 1}));
+  auto source = open_source(request_for("synthetic:duration=1"));
+  EXPECT_EQ(source->negotiate({{2, 2}}), (ViewFormat{{1, 1}}));
   const auto f = source->next();
   ASSERT_TRUE(f);
   EXPECT_EQ(f->block, (std::array<int, 2>{1, 1}));
   EXPECT_EQ(f->left.size(), static_cast<std::size_t>(f->width) * f->height * 4);
+  EXPECT_EQ(source->info().view, (ViewGeometry{f->width, f->height, f->aspect}));
+}
+
+TEST(SourceDrivers, EachRequestGoesToTheFirstRowThatAcceptsItAndTheFileDriverTakesTheRest) {
+  const auto drivers = source_drivers();
+  ASSERT_GE(drivers.size(), 2u);
+  EXPECT_EQ(drivers.back().name, "file");
+  for (const SourceDriver& driver : drivers) {
+    SCOPED_TRACE(std::string(driver.name));
+    EXPECT_FALSE(driver.help.empty());
+    EXPECT_EQ(std::count(driver.help.begin(), driver.help.end(), '\n'), 0);
+  }
+  EXPECT_EQ(source_driver_for(request_for("synthetic:duration=1")).name, "synthetic");
+  EXPECT_EQ(source_driver_for(request_for("movie.mkv")).name, "file");
+  EXPECT_EQ(source_driver_for(request_for("https://example.com/a.mp4")).name, "file");
+}
+
+// A source that does not override seek() (a live capture, say) refuses it in one line naming the
+// input, with status 1, and says so in info().
+class OneFrameSource final : public Source {
+ public:
+  SourceInfo info() const override {
+    SourceInfo info;
+    info.frame_rate = 30;
+    info.live = true;
+    info.description = "capture:test";
+    return info;
+  }
+  std::optional<StereoVideoFrame> next() override { return std::nullopt; }
+};
+
+TEST(SourceDefaults, ASourceThatCannotSeekRefusesInOneLine) {
+  OneFrameSource source;
+  EXPECT_FALSE(source.info().seekable);
+  try {
+    source.seek(1.0);
+    FAIL() << "seek() succeeded";
+  } catch (const UserError& e) {
+    EXPECT_EQ(std::string(e.what()), "capture:test: this input cannot seek");
+    EXPECT_EQ(e.status(), 1);
+  }
+}
+
+TEST_F(StereoFrameSourceTest, AFileSaysItsRateFramesDurationAndThatItCanSeek) {
+  auto source = open_source(request_for(make_sbs_clip(dir)));
+  const SourceInfo info = source->info();
+  EXPECT_DOUBLE_EQ(info.frame_rate, 10.0);
+  ASSERT_TRUE(info.duration_s);
+  EXPECT_NEAR(*info.duration_s, 2.0, 1e-6);
+  EXPECT_TRUE(info.seekable);
+  EXPECT_FALSE(info.live);
+  EXPECT_NE(info.description.find("128x36 ffv1, layout sbs (flag)"), std::string::npos) << info.description;
 }
 
 }  // namespace

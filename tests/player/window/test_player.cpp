@@ -21,7 +21,9 @@
 #include "compositor/gl/gl_compositor.hpp"
 #include "hmz_output/packing.hpp"
 #include "hmz_output/window_display.hpp"
+#include "inputs/source_drivers.hpp"
 #include "player/player.hpp"
+#include "support/image_files.hpp"
 #include "support/media.hpp"
 #include "support/test_support.hpp"
 #include "support/x11_window.hpp"
@@ -124,8 +126,7 @@ TEST_F(PlayerWindowTest, PlaysTheClipInThePackedLayoutWithEachEyesContentAndFram
                     std::vector<float>(l.data(), l.data() + static_cast<std::size_t>(l.width()) * l.height() * 4)});
   };
 
-  auto source = open_stereo_frame_source(
-      StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
+  auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
   const PlayResult result = play(*display, *source, options);
   EXPECT_EQ(result.end, PlayEnd::end_of_file);
   ASSERT_GE(seen.size(), 5u) << "too few frames rendered";
@@ -160,8 +161,7 @@ TEST_F(PlayerWindowTest, SwapEyesPutsTheFirstStoredViewOnTheRight) {
     left_means.push_back(mean_of(read_back(d.packed_framebuffer(), left.x + 560, left.y + 315, 160, 90)));
   };
   std::atomic<bool> stop{false};
-  auto source = open_stereo_frame_source(
-      StereoSourceRequest{clip.string(), "", StereoLayout::sbs, true, std::nullopt, true, false, {}});
+  auto source = open_source(SourceRequest{clip.string(), "", StereoLayout::sbs, true, std::nullopt, true, false});
   // Stop after a few frames: this test is about the routing only.
   auto original = options.after_render;
   options.after_render = [&](const Display& d, double pts) {
@@ -183,35 +183,73 @@ TEST_F(PlayerWindowTest, ClosingTheWindowEndsPlaybackCleanly) {
   options.after_render = [&](const Display&, double) {
     if (++rendered == 3) glfwSetWindowShouldClose(glfwGetCurrentContext(), GLFW_TRUE);
   };
-  auto source = open_stereo_frame_source(
-      StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
+  auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
   const PlayResult result = play(*display, *source, options);
   EXPECT_EQ(result.end, PlayEnd::window_closed);
   EXPECT_EQ(result.counters.shown, 3);
 }
 
+// A stereo photo plays as its one frame, read as convert reads it (the still driver): a JPS (right
+// view first) and an MPO (two JPEGs) both show the left view to the left eye.
+TEST_F(PlayerWindowTest, AStereoPhotoShowsEachEyesView) {
+  const Image red = test::filled_image(320, 180, {0.75f, 0.2f, 0.1f, 1.f});
+  const Image blue = test::filled_image(320, 180, {0.1f, 0.25f, 0.75f, 1.f});
+  Image jps(640, 180);
+  for (int y = 0; y < 180; ++y)
+    for (int x = 0; x < 320; ++x) {
+      jps.at(x, y) = blue.at(x, y);
+      jps.at(320 + x, y) = red.at(x, y);
+    }
+  test::write_test_image(dir_ / "photo.jps", jps, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  test::write_test_image(dir_ / "l.jpg", red, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  test::write_test_image(dir_ / "r.jpg", blue, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  test::write_file(dir_ / "camera.mpo", test::read_file(dir_ / "l.jpg") + test::read_file(dir_ / "r.jpg"));
+
+  PlayerOptions options = silent_options();
+  auto display = open_display(options);
+  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
+  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
+  for (const char* name : {"photo.jps", "camera.mpo"}) {
+    SCOPED_TRACE(name);
+    std::vector<std::pair<Mean, Mean>> seen;
+    options.after_render = [&](const Display& d, double pts) {
+      EXPECT_EQ(pts, 0.0);
+      const auto panel = [&](const EyeArea& a) {
+        return mean_of(
+            read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90));
+      };
+      seen.emplace_back(panel(left), panel(right));
+    };
+    auto source =
+        open_source(SourceRequest{(dir_ / name).string(), "", std::nullopt, false, std::nullopt, true, false});
+    EXPECT_NE(source->info().description.find("still image"), std::string::npos) << source->info().description;
+    const PlayResult result = play(*display, *source, options);
+    EXPECT_EQ(result.end, PlayEnd::end_of_file);
+    EXPECT_EQ(result.counters.shown, 1);
+    ASSERT_EQ(seen.size(), 1u);
+    EXPECT_GT(seen[0].first.r, seen[0].first.b + 0.2);
+    EXPECT_GT(seen[0].second.b, seen[0].second.r + 0.2);
+  }
+}
+
 // A source that records the block of each frame it hands out; with `allow_reduction` false it
-// ignores reduce_views (whole views, as before the player asked for block means).
-class RecordingSource final : public StereoFrameSource {
+// refuses every view format but whole views (as before the player asked for block means).
+class RecordingSource final : public Source {
  public:
-  RecordingSource(std::unique_ptr<StereoFrameSource> inner, bool allow_reduction)
+  RecordingSource(std::unique_ptr<Source> inner, bool allow_reduction)
       : inner_(std::move(inner)), allow_(allow_reduction) {}
   std::optional<StereoVideoFrame> next() override {
     auto f = inner_->next();
     if (f) blocks.push_back(f->block);
     return f;
   }
-  double frame_rate() const override { return inner_->frame_rate(); }
-  std::optional<long> expected_frames() const override { return inner_->expected_frames(); }
-  std::optional<double> duration_s() const override { return inner_->duration_s(); }
+  SourceInfo info() const override { return inner_->info(); }
   void seek(double seconds) override { inner_->seek(seconds); }
-  std::array<int, 2> reduce_views(const ViewBlockChooser& choose) override {
-    return allow_ ? inner_->reduce_views(choose) : std::array<int, 2>{1, 1};
-  }
+  ViewFormat negotiate(const ViewFormat& wanted) override { return allow_ ? inner_->negotiate(wanted) : ViewFormat{}; }
   std::vector<std::array<int, 2>> blocks;
 
  private:
-  std::unique_ptr<StereoFrameSource> inner_;
+  std::unique_ptr<Source> inner_;
   bool allow_;
 };
 
@@ -234,9 +272,8 @@ TEST_F(PlayerWindowTest, PlaysFromTheCompositorsBlockMeansWithTheSameImageAsFrom
   std::vector<std::array<int, 2>> blocks[2];
   for (bool reduce : {true, false}) {
     stop = false;
-    RecordingSource source(open_stereo_frame_source(StereoSourceRequest{
-                               clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}}),
-                           reduce);
+    RecordingSource source(
+        open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false}), reduce);
     play(*display, source, options, &stop);
     blocks[reduce ? 0 : 1] = source.blocks;
   }
@@ -319,8 +356,7 @@ TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessag
         pressed = true;
       }
     };
-    auto source = open_stereo_frame_source(
-        StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
+    auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
     const PlayResult result = play(*display, *source, options);
     EXPECT_EQ(result.end, PlayEnd::end_of_file);
     ASSERT_TRUE(pressed);
@@ -462,8 +498,7 @@ TEST_F(PlayerWindowTest, NoFrameCompositedAheadShowsAStateAKeyHasChanged) {
       shown[path][{typed, pts}] = Frame{panel(d, left), panel(d, right)};
       if (typed < keys.size() && pts >= keys[typed].first - lead) display.type(keys[typed++].second);
     };
-    auto source = open_stereo_frame_source(
-        StereoSourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false, {}});
+    auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
     results[path] = play(display, *source, options);
     EXPECT_EQ(results[path].end, PlayEnd::end_of_file);
     ASSERT_EQ(typed, keys.size());

@@ -1,6 +1,6 @@
-#include "inputs/stereo_frame_source.hpp"
-#include "core/printable.hpp"
-
+// The FFmpeg file driver: a media file in any layout, `alt` (frame-sequential) and `pair` (a second
+// file for the right view, --right) included. Last in the table: it takes whatever the others do
+// not, and FFmpeg says what it cannot read.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -8,15 +8,15 @@
 #include <cstring>
 #include <utility>
 
+#include "core/printable.hpp"
 #include "core/user_error.hpp"
 #include "inputs/audio_source.hpp"
 #include "inputs/file_carried_streams.hpp"
-#include "inputs/synthetic_source.hpp"
-#include "inputs/synthetic_tone.hpp"
+#include "inputs/source.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
 
-namespace nelf {
+namespace nelf::drivers {
 namespace {
 
 // Copies `rect` of a decoded frame into a tightly packed buffer.
@@ -31,54 +31,9 @@ std::vector<std::uint8_t> copy_region(const VideoFrame& frame, const PixelRect& 
   return out;
 }
 
-std::vector<std::uint8_t> to_rgba8(const Image& image) {
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(image.width()) * image.height() * 4);
-  const float* p = image.data();
-  for (std::size_t i = 0; i < out.size(); ++i)
-    out[i] = static_cast<std::uint8_t>(std::lround(std::clamp(p[i], 0.f, 1.f) * 255.f));
-  return out;
-}
-
-class SyntheticFrameSource final : public StereoFrameSource {
+class FileFrameSource final : public Source {
  public:
-  SyntheticFrameSource(const std::string& spec, double start_s)
-      : clip_(parse_synthetic_spec(spec)), next_(static_cast<int>(std::lround(start_s * clip_.settings().fps))) {}
-  std::optional<StereoVideoFrame> next() override {
-    if (next_ >= clip_.frame_count()) return std::nullopt;
-    const StereoPair pair = clip_.render(next_);
-    StereoVideoFrame f{pair.left.image.width(),
-                       pair.left.image.height(),
-                       8,
-                       to_rgba8(pair.left.image),
-                       to_rgba8(pair.right.image),
-                       pair.left.aspect(),
-                       static_cast<double>(next_ - first_) / clip_.settings().fps,
-                       {1, 1}};
-    ++next_;
-    return f;
-  }
-  double frame_rate() const override { return clip_.settings().fps; }
-  std::optional<long> expected_frames() const override { return clip_.frame_count() - first_; }
-  std::optional<double> duration_s() const override {
-    return static_cast<double>(clip_.frame_count() - first_) / clip_.settings().fps;
-  }
-  void seek(double seconds) override {
-    const int target = first_ + static_cast<int>(std::lround(std::max(0.0, seconds) * clip_.settings().fps));
-    next_ = std::clamp(target, first_, clip_.frame_count());
-  }
-  OpenedAudio open_audio(AudioFormat format) const override {
-    return {open_synthetic_tone(clip_.settings(), first_, format), {}};
-  }
-
- private:
-  SyntheticClip clip_;
-  int next_ = 0;
-  int first_ = next_;
-};
-
-class FileFrameSource final : public StereoFrameSource {
- public:
-  FileFrameSource(const StereoSourceRequest& r)
+  FileFrameSource(const SourceRequest& r)
       : path_(r.input), allow_network_(r.allow_network), source_(open(r.input, r)) {
     if (r.start_s) source_.seek(*r.start_s);
     pending_ = source_.next_frame();
@@ -126,11 +81,10 @@ class FileFrameSource final : public StereoFrameSource {
         throw UserError(fmt::format("{}: {}", r.input, e.what()), 1);
       }
     }
-    if (r.view_block) reduce_views(r.view_block);
-    if (!r.quiet)
-      fmt::print(stderr, "nelf: {}: {}x{} {}, layout {}{} ({})\n", printable(r.input), source_.info().width,
-                 source_.info().height, source_.info().video_codec, to_string(decision_.layout),
-                 decision_.swap_eyes ? " swapped" : "", to_string(decision_.rule));
+    description_ = fmt::format("{}: {}x{} {}, layout {}{} ({})", r.input, source_.info().width, source_.info().height,
+                               source_.info().video_codec, to_string(decision_.layout),
+                               decision_.swap_eyes ? " swapped" : "", to_string(decision_.rule));
+    if (!r.quiet) fmt::print(stderr, "nelf: {}\n", printable(description_));
   }
 
   std::optional<StereoVideoFrame> next() override {
@@ -179,31 +133,31 @@ class FileFrameSource final : public StereoFrameSource {
     return out;
   }
 
-  double frame_rate() const override {
-    const double fps = source_.info().fps > 0 ? source_.info().fps : 25.0;
-    return decision_.layout == StereoLayout::alt ? fps / 2 : fps;
-  }
-  std::optional<long> expected_frames() const override {
-    const VideoInfo& info = source_.info();
-    std::optional<double> frames;
-    if (info.frame_count)
-      frames = static_cast<double>(*info.frame_count);
-    else if (info.duration_s && info.fps > 0)
-      frames = *info.duration_s * info.fps;
-    if (!frames) return std::nullopt;
-    if (decision_.layout == StereoLayout::alt) *frames /= 2;
-    return static_cast<long>(std::lround(*frames));
-  }
   OpenedAudio open_audio(AudioFormat format) const override {
     return open_file_audio(path_, origin_s_, allow_network_, format);
   }
   std::unique_ptr<CarriedStreams> open_carried_streams() const override {
     return open_file_carried_streams(path_, origin_s_, allow_network_);
   }
-  std::optional<double> duration_s() const override {
-    const auto& d = source_.info().duration_s;
-    if (!d) return std::nullopt;
-    return std::max(0.0, *d - (origin_s_ - source_.info().start_time_s));
+  SourceInfo info() const override {
+    const VideoInfo& video = source_.info();
+    SourceInfo info;
+    const double fps = video.fps > 0 ? video.fps : 25.0;
+    info.frame_rate = decision_.layout == StereoLayout::alt ? fps / 2 : fps;
+    std::optional<double> frames;
+    if (video.frame_count)
+      frames = static_cast<double>(*video.frame_count);
+    else if (video.duration_s && video.fps > 0)
+      frames = *video.duration_s * video.fps;
+    if (frames) {
+      if (decision_.layout == StereoLayout::alt) *frames /= 2;
+      info.expected_frames = static_cast<long>(std::lround(*frames));
+    }
+    if (video.duration_s) info.duration_s = std::max(0.0, *video.duration_s - (origin_s_ - video.start_time_s));
+    info.seekable = video.seekable && (!right_ || right_->info().seekable);
+    info.description = description_;
+    info.view = view_geometry();
+    return info;
   }
   void seek(double seconds) override {
     // The source's own clock starts at its start time; pts_s 0 is origin_s_.
@@ -219,14 +173,12 @@ class FileFrameSource final : public StereoFrameSource {
   // The compositor's first prefilter pass (a block mean over the view) done by swscale while it
   // converts the decoded YUV: the GL stage then uploads and reads 1/block² of the texels, and the
   // full-resolution RGBA frame is never made. VideoSource keeps the regions across seeks.
-  std::array<int, 2> reduce_views(const ViewBlockChooser& choose) override {
-    if (decision_.layout == StereoLayout::pair) return block_;  // two decoders: whole frames
+  ViewFormat negotiate(const ViewFormat& format) override {
+    if (decision_.layout == StereoLayout::pair) return {block_};  // two decoders: whole frames
     const bool whole = decision_.layout == StereoLayout::alt;
     const PixelRect left = whole ? PixelRect{0, 0, alt_width_, alt_height_} : regions_.left;
     const PixelRect right = whole ? left : regions_.right;
-    const double aspect = whole ? alt_aspect_ : regions_.display_aspect;
-    std::array<int, 2> block{1, 1};
-    if (choose) block = choose(left.width, left.height, aspect);
+    std::array<int, 2> block = format.block;
     std::vector<ReducedRegion> wanted;
     if (block[0] > 1 || block[1] > 1) {
       wanted.push_back({left.x, left.y, left.width, left.height, block[0], block[1]});
@@ -242,14 +194,14 @@ class FileFrameSource final : public StereoFrameSource {
       throw UserError(e.what(), 1);
     }
     block_ = block;
-    return block_;
+    return {block_};
   }
   std::int64_t lost_frames() const override {
     return source_.stats().problems() + (right_ ? right_->stats().problems() : 0);
   }
 
  private:
-  static VideoSource open(const std::string& path, const StereoSourceRequest& r) {
+  static VideoSource open(const std::string& path, const SourceRequest& r) {
     try {
       return VideoSource(path, VideoSourceOptions{r.allow_network, true, r.max_pixels});
     } catch (const VideoError& e) {
@@ -264,33 +216,32 @@ class FileFrameSource final : public StereoFrameSource {
       throw UserError(e.what(), 1);
     }
   }
+  ViewGeometry view_geometry() const {
+    if (decision_.layout == StereoLayout::alt || decision_.layout == StereoLayout::pair)
+      return {alt_width_, alt_height_, alt_aspect_};
+    return {regions_.left.width, regions_.left.height, regions_.display_aspect};
+  }
   int width() const { return source_.info().width; }
   int height() const { return source_.info().height; }
 
   std::string path_;
   bool allow_network_;  // for the audio and carried streams, opened on their own
+  std::string description_;
   VideoSource source_;
   std::optional<VideoSource> right_;
   std::optional<VideoFrame> pending_;
   LayoutDecision decision_;
   ViewRegions regions_;
-  int alt_width_ = 0, alt_height_ = 0;  // layout alt: each frame is a whole view of this size
+  int alt_width_ = 0, alt_height_ = 0;  // layouts alt and pair: each frame is a whole view of this size
   double alt_aspect_ = 0.0;
   double origin_s_ = 0.0;
-  std::array<int, 2> block_{1, 1};  // what reduce_views() set
+  std::array<int, 2> block_{1, 1};  // what negotiate() set
 };
 
 }  // namespace
 
-std::unique_ptr<StereoFrameSource> open_stereo_frame_source(const StereoSourceRequest& request) {
-  if (is_synthetic_spec(request.input)) {
-    try {
-      return std::make_unique<SyntheticFrameSource>(request.input, request.start_s.value_or(0.0));
-    } catch (const std::invalid_argument& e) {
-      throw UserError(e.what(), 2);
-    }
-  }
-  return std::make_unique<FileFrameSource>(request);
-}
+bool accepts_file(const SourceRequest& /*request*/) { return true; }
 
-}  // namespace nelf
+std::unique_ptr<Source> open_file(const SourceRequest& request) { return std::make_unique<FileFrameSource>(request); }
+
+}  // namespace nelf::drivers

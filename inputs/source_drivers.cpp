@@ -1,0 +1,40 @@
+#include "inputs/source_drivers.hpp"
+
+#include <stdexcept>
+
+namespace nelf {
+
+// Each driver's two functions, defined in its own file.
+namespace drivers {
+bool accepts_synthetic(const SourceRequest& request);
+std::unique_ptr<Source> open_synthetic(const SourceRequest& request);
+bool accepts_still(const SourceRequest& request);
+std::unique_ptr<Source> open_still(const SourceRequest& request);
+bool accepts_file(const SourceRequest& request);
+std::unique_ptr<Source> open_file(const SourceRequest& request);
+}  // namespace drivers
+
+namespace {
+
+constexpr SourceDriver kDrivers[] = {
+    {"synthetic", "synthetic:[duration=S,fps=N,size=WxH]: a stereo clip nelf renders itself, with a tone",
+     drivers::accepts_synthetic, drivers::open_synthetic},
+    {"still", "a stereo photo OpenImageIO reads (.jps, .mpo, .png, .jpg, .tif, .exr, ...; two with --right)",
+     drivers::accepts_still, drivers::open_still},
+    {"file", "a video FFmpeg reads, in any layout (alt: frame-sequential; pair: the right view with --right)",
+     drivers::accepts_file, drivers::open_file},
+};
+
+}  // namespace
+
+std::span<const SourceDriver> source_drivers() { return kDrivers; }
+
+const SourceDriver& source_driver_for(const SourceRequest& request) {
+  for (const SourceDriver& driver : kDrivers)
+    if (driver.accepts(request)) return driver;
+  throw std::logic_error("no source driver accepts " + request.input);  // the file driver takes everything
+}
+
+std::unique_ptr<Source> open_source(const SourceRequest& request) { return source_driver_for(request).open(request); }
+
+}  // namespace nelf

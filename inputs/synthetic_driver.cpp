@@ -1,0 +1,81 @@
+// The synthetic driver: `synthetic:[duration=S,fps=N,size=WxH]`, the built-in clip nelf renders
+// itself (inputs/synthetic_source), delivered as whole views.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "core/user_error.hpp"
+#include "inputs/source.hpp"
+#include "inputs/synthetic_source.hpp"
+#include "inputs/synthetic_tone.hpp"
+
+namespace nelf::drivers {
+namespace {
+
+std::vector<std::uint8_t> to_rgba8(const Image& image) {
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(image.width()) * image.height() * 4);
+  const float* p = image.data();
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = static_cast<std::uint8_t>(std::lround(std::clamp(p[i], 0.f, 1.f) * 255.f));
+  return out;
+}
+
+class SyntheticFrameSource final : public Source {
+ public:
+  SyntheticFrameSource(const std::string& spec, double start_s)
+      : clip_(parse_synthetic_spec(spec)), next_(static_cast<int>(std::lround(start_s * clip_.settings().fps))) {}
+  std::optional<StereoVideoFrame> next() override {
+    if (next_ >= clip_.frame_count()) return std::nullopt;
+    const StereoPair pair = clip_.render(next_);
+    StereoVideoFrame f{pair.left.image.width(),
+                       pair.left.image.height(),
+                       8,
+                       to_rgba8(pair.left.image),
+                       to_rgba8(pair.right.image),
+                       pair.left.aspect(),
+                       static_cast<double>(next_ - first_) / clip_.settings().fps,
+                       {1, 1},
+                       nullptr};
+    ++next_;
+    return f;
+  }
+  SourceInfo info() const override {
+    const SyntheticClipSettings& s = clip_.settings();
+    SourceInfo info;
+    info.frame_rate = s.fps;
+    info.expected_frames = clip_.frame_count() - first_;
+    info.duration_s = static_cast<double>(clip_.frame_count() - first_) / s.fps;
+    info.seekable = true;
+    info.description = fmt::format("synthetic clip, two {}x{} views at {} fps", s.eye_width, s.eye_height, s.fps);
+    info.view = {s.eye_width, s.eye_height, static_cast<double>(s.eye_width) / s.eye_height};
+    return info;
+  }
+  void seek(double seconds) override {
+    const int target = first_ + static_cast<int>(std::lround(std::max(0.0, seconds) * clip_.settings().fps));
+    next_ = std::clamp(target, first_, clip_.frame_count());
+  }
+  OpenedAudio open_audio(AudioFormat format) const override {
+    return {open_synthetic_tone(clip_.settings(), first_, format), {}};
+  }
+
+ private:
+  SyntheticClip clip_;
+  int next_ = 0;
+  int first_ = next_;
+};
+
+}  // namespace
+
+bool accepts_synthetic(const SourceRequest& request) { return is_synthetic_spec(request.input); }
+
+std::unique_ptr<Source> open_synthetic(const SourceRequest& request) {
+  try {
+    return std::make_unique<SyntheticFrameSource>(request.input, request.start_s.value_or(0.0));
+  } catch (const std::invalid_argument& e) {
+    throw UserError(e.what(), 2);
+  }
+}
+
+}  // namespace nelf::drivers

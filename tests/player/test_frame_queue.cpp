@@ -1,0 +1,72 @@
+// The play decode thread applies a view format asked for on the render thread (a key changed the
+// optics) before it decodes the next frame, and frames carry the format they were made in.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "inputs/source.hpp"
+#include "player/frame_queue.hpp"
+
+namespace nelf {
+namespace {
+
+// Endless 8×4 views at 10 fps in whatever block was last negotiated (any block that divides them).
+class FormatFollowingSource final : public Source {
+ public:
+  SourceInfo info() const override {
+    SourceInfo info;
+    info.frame_rate = 10;
+    info.view = {8, 4, 2.0};
+    return info;
+  }
+  std::optional<StereoVideoFrame> next() override {
+    StereoVideoFrame f;
+    f.width = 8;
+    f.height = 4;
+    f.block = block_;
+    f.left.assign(static_cast<std::size_t>(8 / block_[0]) * (4 / block_[1]) * 4, 0);
+    f.right = f.left;
+    f.pts_s = 0.1 * static_cast<double>(frames_++);
+    return f;
+  }
+  ViewFormat negotiate(const ViewFormat& wanted) override {
+    negotiated_on = std::this_thread::get_id();
+    block_ = 8 % wanted.block[0] == 0 && 4 % wanted.block[1] == 0 ? wanted.block : std::array<int, 2>{1, 1};
+    return {block_};
+  }
+  std::atomic<std::thread::id> negotiated_on{};
+
+ private:
+  std::array<int, 2> block_{1, 1};
+  long frames_ = 0;
+};
+
+TEST(FrameQueue, AViewFormatAskedForIsNegotiatedOnTheDecodeThreadAndCarriedByTheNextFrames) {
+  FormatFollowingSource source;
+  playback::FrameQueue queue(2);
+  std::thread decoder([&] { playback::decode_loop(source, queue); });
+  const auto next_frame = [&] {
+    EXPECT_TRUE(queue.wait_for_frame(std::chrono::seconds(5)));
+    return queue.pop(0, true);
+  };
+  EXPECT_EQ(next_frame()->block, (std::array<int, 2>{1, 1}));
+  queue.negotiate({{2, 2}});
+  // Frames decoded before the request keep their whole views; the next ones are 2×2 means.
+  std::vector<std::array<int, 2>> blocks;
+  while (blocks.size() < 6) blocks.push_back(next_frame()->block);
+  const std::thread::id decode_thread = decoder.get_id();
+  queue.stop();
+  decoder.join();
+  EXPECT_EQ(blocks.back(), (std::array<int, 2>{2, 2}));
+  const auto first_reduced = std::find(blocks.begin(), blocks.end(), std::array<int, 2>{2, 2});
+  EXPECT_TRUE(std::all_of(first_reduced, blocks.end(), [](auto b) { return b == std::array<int, 2>{2, 2}; }));
+  EXPECT_EQ(source.negotiated_on.load(), decode_thread);
+}
+
+}  // namespace
+}  // namespace nelf
