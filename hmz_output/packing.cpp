@@ -1,24 +1,8 @@
 #include "hmz_output/packing.hpp"
 
 #include <fmt/format.h>
-#include <algorithm>
 
 namespace nelf {
-namespace {
-
-// Copies `eye` into `frame` with its top-left corner at `origin`, clipped to `area`: borders stay
-// as they are (black) when the eye is smaller, the eye is cropped evenly when it is larger.
-void blit_centred(Image& frame, const Image& eye, const EyeArea& area, std::pair<int, int> origin) {
-  const int dx = origin.first - area.x, dy = origin.second - area.y;
-  const int x_begin = std::max(0, dx), x_end = std::min(area.width, dx + eye.width());
-  const int y_begin = std::max(0, dy), y_end = std::min(area.height, dy + eye.height());
-  for (int y = y_begin; y < y_end; ++y) {
-    const Rgba* src = &eye.at(x_begin - dx, y - dy);
-    std::copy(src, src + (x_end - x_begin), &frame.at(area.x + x_begin, area.y + y));
-  }
-}
-
-}  // namespace
 
 std::optional<EyeArea> eye_area(const Signal& signal, Eye eye, int eye_w, int eye_h) {
   const bool right = eye == Eye::right;
@@ -41,11 +25,8 @@ Image pack_eyes(const Signal& signal, const Image& left, const Image& right) {
   if (left.width() != right.width() || left.height() != right.height())
     throw std::invalid_argument(fmt::format("pack_eyes: eye images differ in size ({}x{} and {}x{})", left.width(),
                                             left.height(), right.width(), right.height()));
-  const PackedLayout layout = packed_layout(signal, {left.width(), left.height()});
-  Image frame(layout.packed[0], layout.packed[1]);  // black, alpha 1
-  for (int e = 0; e < 2; ++e)
-    if (layout.areas[e]) blit_centred(frame, e == 0 ? left : right, *layout.areas[e], *layout.origins[e]);
-  return frame;
+  // The one placement: the packed layout's, as every video frame's (core/packed_layout.hpp).
+  return place_eyes(packed_layout(signal, {left.width(), left.height()}), EyeImages{left, right});
 }
 
 PackedLayout packed_layout(const Signal& signal, std::array<int, 2> eye) {

@@ -13,32 +13,13 @@
 namespace nelf {
 namespace {
 
+using test::ScopedEnv;
+
 using test::files_in;
 using test::run_command;
 using test::run_nelf;
 using test::shell_quote;
 using test::TempDir;
-
-// Sets an environment variable for the nelf processes a test starts; restores it after.
-class ScopedEnvironment {
- public:
-  ScopedEnvironment(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    ::setenv(name, value.c_str(), 1);
-  }
-  ~ScopedEnvironment() {
-    if (old_)
-      ::setenv(name_, old_->c_str(), 1);
-    else
-      ::unsetenv(name_);
-  }
-  ScopedEnvironment(const ScopedEnvironment&) = delete;
-  ScopedEnvironment& operator=(const ScopedEnvironment&) = delete;
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
 
 TEST(ImageLibrary, TheNelfBinaryDoesNotLinkOpenImageIO) {
   const auto r = run_command("ldd " + shell_quote(NELF_BINARY));
@@ -49,7 +30,7 @@ TEST(ImageLibrary, TheNelfBinaryDoesNotLinkOpenImageIO) {
 
 TEST(ImageLibrary, VideoConversionAndProbeRunWithoutIt) {
   TempDir dir;
-  const ScopedEnvironment no_module("NELF_IMAGE_LIBRARY", (dir / "no-such-module.so").string());
+  const ScopedEnv no_module("NELF_IMAGE_LIBRARY", (dir / "no-such-module.so").string());
   const auto converted =
       run_nelf("convert synthetic:duration=0.25,size=160x90 " + shell_quote((dir / "out.mkv").string()) +
                " --profile " + shell_quote(test::write_small_profile(dir).string()) + " --quiet");
@@ -63,7 +44,7 @@ TEST(ImageLibrary, AMissingModuleIsOneClearLineAndNoOutput) {
   const auto input = dir / "in.png";
   test::write_test_image(input, test::filled_image(64, 32, {0.5f, 0.2f, 0.1f, 1.f}), 3);
   const auto profile = test::write_small_profile(dir);
-  const ScopedEnvironment no_module("NELF_IMAGE_LIBRARY", (dir / "no-such-module.so").string());
+  const ScopedEnv no_module("NELF_IMAGE_LIBRARY", (dir / "no-such-module.so").string());
   test::expect_clean_failure(
       dir,
       "convert " + shell_quote(input.string()) + " " + shell_quote((dir / "out.png").string()) + " --profile " +
@@ -82,7 +63,7 @@ TEST(ImageLibrary, AModuleFromSomethingElseIsRefused) {
   ASSERT_EQ(libm.status, 0);
   std::string path = libm.out.substr(0, libm.out.find('\n'));
   if (path.empty()) GTEST_SKIP() << "no libm.so.6 in ldconfig's cache";
-  const ScopedEnvironment other("NELF_IMAGE_LIBRARY", path);
+  const ScopedEnv other("NELF_IMAGE_LIBRARY", path);
   test::expect_clean_failure(dir,
                              "convert " + shell_quote(input.string()) + " " + shell_quote((dir / "out.png").string()) +
                                  " --profile " + shell_quote(profile.string()),

@@ -17,27 +17,10 @@
 namespace nelf {
 namespace {
 
+using test::ScopedEnv;
+
 using test::make_media;
 using test::TempDir;
-
-// Sets an environment variable for the scope of a test.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) {
-    if (const char* old = std::getenv(name)) previous_ = old;
-    setenv(name, value, 1);
-  }
-  ~ScopedEnv() {
-    if (previous_)
-      setenv(name_, previous_->c_str(), 1);
-    else
-      unsetenv(name_);
-  }
-
- private:
-  const char* name_;
-  std::optional<std::string> previous_;
-};
 
 TEST(AudioSource, DecodesMonoToInterleavedStereoAtTheOutputRateWithTimestamps) {
   TempDir dir;

@@ -98,4 +98,20 @@ ipd_mm = 63.0
                        "small-panel test profile");
 }
 
+std::vector<std::uint8_t> block_means(const Image& view, std::array<int, 2> block) {
+  const int w = view.width() / block[0], h = view.height() / block[1];
+  std::vector<std::uint8_t> means(static_cast<std::size_t>(w) * h * 4);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 4; ++c) {
+        double sum = 0.0;
+        for (int j = 0; j < block[1]; ++j)
+          for (int i = 0; i < block[0]; ++i)
+            sum += view.data()[(static_cast<std::size_t>(y * block[1] + j) * view.width() + x * block[0] + i) * 4 + c];
+        means[(static_cast<std::size_t>(y) * w + x) * 4 + c] =
+            static_cast<std::uint8_t>(std::lround(std::clamp(sum / (block[0] * block[1]), 0.0, 1.0) * 255.0));
+      }
+  return means;
+}
+
 }  // namespace nelf::test

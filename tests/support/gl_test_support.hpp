@@ -1,8 +1,11 @@
 #pragma once
 // Shared pieces of the GL tests: one headless context for the whole run, procedural test charts,
 // image comparison.
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/gl/egl_context.hpp"
 #include "core/image.hpp"
@@ -27,5 +30,8 @@ double max_abs_difference(const Image& a, const Image& b);
 // hmz-t1 with a 320×180 panel of 4× the pixel pitch (same physical size and optics, 16× fewer
 // pixels), so the 16×16 reference stays fast.
 Profile small_panel_profile();
+
+// `view` averaged in `block` cells, RGBA8, as swscale's area filter hands them over.
+std::vector<std::uint8_t> block_means(const Image& view, std::array<int, 2> block);
 
 }  // namespace nelf::test

@@ -1,6 +1,7 @@
 #pragma once
 // Helpers shared by the tests: temporary directories, running the nelf binary, small profiles.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,21 @@ inline CommandResult run_nelf(const std::string& args) { return run_command(std:
 // `dir` exactly as it was (no output, no temporary file).
 void expect_clean_failure(const TempDir& dir, const std::string& args, int status, const std::string& expected);
 #endif
+
+// Sets (value null: unsets) an environment variable for the scope of a test, and the nelf
+// processes it starts; restores it after.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value);
+  ScopedEnv(const char* name, const std::string& value) : ScopedEnv(name, value.c_str()) {}
+  ~ScopedEnv();
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
 
 // Quotes a string for /bin/sh.
 std::string shell_quote(const std::string& s);
