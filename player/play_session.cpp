@@ -39,13 +39,13 @@ GlPackedTarget checked_target(const Display& display, FrameCompositor& composito
   return GlPackedTarget{display.packed_framebuffer(), display.packed_texture(), packed};
 }
 
-// The master clock: the sound's when there is sound. It starts with the
+// The master clock: the sound's when there is sound (the tests' stepped clock when they give one). It starts with the
 // first frame on screen.
 PlaybackClock& paused_master_clock(PlaySound& sound, const PlayerOptions& options) {
   if (!options.quiet)
     std::fprintf(stderr, sound.playing() ? "nelf: sound: %s\n" : "nelf: %s: playing without sound\n",
                  sound.description().c_str());
-  PlaybackClock& clock = sound.clock();
+  PlaybackClock& clock = options.clock ? *options.clock : sound.clock();
   clock.set_paused(true);
   return clock;
 }
@@ -104,11 +104,17 @@ void PlaySession::start_clock() {
   clock.set_paused(false);
 }
 
-// After the next vblank, or once rendered and presented.
-double PlaySession::seen_after() const { return display.vsync() ? refresh_period : render_time.median_s(); }
+// After the next vblank, or once rendered and presented (at once on a stepped clock).
+double PlaySession::seen_after() const {
+  if (options.clock) return 0.0;
+  return display.vsync() ? refresh_period : render_time.median_s();
+}
 
 void PlaySession::wait_for_next_refresh() {
-  if (!display.vsync()) ticker.sleep_to_next();
+  if (options.clock)
+    options.clock->advance(refresh_period);
+  else if (!display.vsync())
+    ticker.sleep_to_next();
 }
 
 PlayResult PlaySession::finish(std::int64_t composited_ahead) {

@@ -41,7 +41,8 @@ struct PlaySession {
   void start_clock();
   // When a refresh starting now will be seen, after the master clock's now.
   double seen_after() const;
-  // To the next refresh: with vsync, present() has waited; without, the ticker sleeps to it.
+  // To the next refresh: with vsync, present() has waited; without, the ticker sleeps to it (a
+  // stepped clock is advanced instead).
   void wait_for_next_refresh();
   // Stops the decoder and the sound; the counts of the run.
   PlayResult finish(std::int64_t composited_ahead);

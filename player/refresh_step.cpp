@@ -21,6 +21,7 @@ Refresh choose_frame(PlaySession& s) {
   PlayState& state = s.state;
   Refresh r;
   r.decided_at = Steady::now();
+  if (s.options.clock) s.queue.wait_until_full();  // a stepped clock waits for the decoder
   bool end = false;
   r.queued = s.queue.snapshot(end);
   if (state.awaiting_seek && (!r.queued.empty() || end)) {
