@@ -106,6 +106,11 @@ class FrameQueue {
     return std::vector<Frame>(items_.begin(),
                               items_.begin() + static_cast<std::ptrdiff_t>(std::min(count, items_.size())));
   }
+  // Waits until the queue is full, or the stream has ended (or failed, or the queue was stopped).
+  void wait_until_full() {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return items_.size() >= capacity_ || (end_ && !seek_to_) || error_ || stop_; });
+  }
   // Waits up to `timeout` for a frame (or the end); true when one is there.
   bool wait_for_frame(std::chrono::milliseconds timeout) {
     std::unique_lock lock(mutex_);

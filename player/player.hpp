@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "compositor/compositor.hpp"
@@ -17,6 +18,7 @@
 #include "inputs/source.hpp"
 #include "optics/profile.hpp"
 #include "player/frame_scheduler.hpp"
+#include "player/stepped_clock.hpp"
 
 namespace nelf {
 
@@ -35,6 +37,11 @@ struct PlayerOptions {
   // Called after each new frame is rendered into the packed framebuffer, before present(); the
   // display's context is current (tests read the frame back here).
   std::function<void(const Display&, double pts_s)> after_render;
+  // Tests: the master clock instead of the sound's or the system's, advanced one refresh period
+  // after each refresh instead of waiting for the next one. Rendering takes no time on it, and each
+  // refresh waits for the decoder to fill the queue (or end), so that the frames shown, repeated
+  // and dropped are what FrameScheduler makes of the clip's timestamps and the refresh rate.
+  std::shared_ptr<playback::SteppedClock> clock;
 };
 
 enum class PlayEnd { end_of_file, quit_key, window_closed, interrupted };

@@ -68,5 +68,47 @@ TEST(FrameQueue, AViewFormatAskedForIsNegotiatedOnTheDecodeThreadAndCarriedByThe
   EXPECT_EQ(source.negotiated_on.load(), decode_thread);
 }
 
+// What a stepped clock waits for before each refresh: a full queue, or the end of a stream shorter
+// than the queue (and stop() ends the wait however full the queue is).
+TEST(FrameQueue, WaitUntilFullReturnsWithAFullQueueOrAtTheEnd) {
+  FormatFollowingSource endless;
+  playback::FrameQueue queue(4);
+  std::thread decoder([&] { playback::decode_loop(endless, queue); });
+  queue.wait_until_full();
+  bool end = true;
+  EXPECT_EQ(queue.snapshot(end).size(), 4u);
+  EXPECT_FALSE(end);
+  queue.pop(0, true);
+  queue.wait_until_full();
+  EXPECT_EQ(queue.snapshot(end).size(), 4u);
+  queue.stop();
+  decoder.join();
+
+  class ThreeFrames final : public Source {
+   public:
+    SourceInfo info() const override { return {}; }
+    std::optional<StereoVideoFrame> next() override {
+      if (frames_ == 3) return std::nullopt;
+      StereoVideoFrame f;
+      f.pts_s = 0.1 * frames_++;
+      return f;
+    }
+
+   private:
+    int frames_ = 0;
+  } short_clip;
+  playback::FrameQueue short_queue(4);
+  std::thread short_decoder([&] { playback::decode_loop(short_clip, short_queue); });
+  short_queue.wait_until_full();
+  EXPECT_EQ(short_queue.snapshot(end).size(), 3u);
+  EXPECT_TRUE(end);
+  short_queue.stop();
+  short_decoder.join();
+
+  playback::FrameQueue stopped(4);
+  stopped.stop();
+  stopped.wait_until_full();  // returns at once
+}
+
 }  // namespace
 }  // namespace nelf

@@ -1,19 +1,12 @@
-// The player engine on a real window (private Xvfb): a generated clip with distinct left/right
-// content and a moving box, read back from the display's packed framebuffer after every new frame.
+// The player engine on a real window (private Xvfb): what only a window does. Closing it ends play;
+// what the player renders reaches the window. What play does with frames, keys and the compositor's
+// paths is tested on the offscreen output (tests/player/gl).
 #include <gtest/gtest.h>
 
-#include <epoxy/gl.h>
-#include <fmt/format.h>
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
-#include <algorithm>
-#include <cmath>
-#include <cstdlib>
-#include <map>
 #include <memory>
-#include <optional>
-#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,7 +17,7 @@
 #include "inputs/source_drivers.hpp"
 #include "player/player.hpp"
 #include "support/image_files.hpp"
-#include "support/media.hpp"
+#include "support/player_tests.hpp"
 #include "support/test_support.hpp"
 #include "support/x11_window.hpp"
 #include "support/xvfb.hpp"
@@ -32,48 +25,9 @@
 namespace nelf {
 namespace {
 
-Profile small_profile(const test::TempDir& dir) { return load_profile(test::write_small_profile(dir).string()); }
-
-// 2 s (or `seconds`) at 30 fps, side by side: left view red-ish, right view blue-ish, each with a
-// white box that moves 5 px per frame (the frame number, visible).
-std::filesystem::path make_clip(const test::TempDir& dir, int seconds = 2) {
-  const std::string d = ":d=" + std::to_string(seconds);
-  return test::make_media(
-      dir / "clip.mp4",
-      "-f lavfi -i color=c=0xC03020:s=320x180:r=30" + d + " -f lavfi -i color=c=0x2040C0:s=320x180:r=30" + d +
-          " -f lavfi -i color=c=white:s=20x60:r=30" + d +
-          " -filter_complex "
-          "\"[2]split[b1][b2];[0][b1]overlay=x='mod(n*5,300)':y=60[l];[1][b2]overlay=x='mod(n*5,300)':y=60[r];"
-          "[l][r]hstack\" -c:v libx264 -preset ultrafast -pix_fmt yuv420p");
-}
-
-struct Mean {
-  double r = 0, g = 0, b = 0, max = 0;
-};
-Mean mean_of(const Image& image) {
-  Mean m;
-  const std::size_t n = static_cast<std::size_t>(image.width()) * image.height();
-  for (std::size_t i = 0; i < n; ++i) {
-    m.r += image.data()[i * 4];
-    m.g += image.data()[i * 4 + 1];
-    m.b += image.data()[i * 4 + 2];
-    for (int c = 0; c < 3; ++c) m.max = std::max(m.max, static_cast<double>(image.data()[i * 4 + c]));
-  }
-  m.r /= n;
-  m.g /= n;
-  m.b /= n;
-  return m;
-}
-
-// Pixels of the calibration grid's yellow centre cross and its lines (neither view has yellow).
-int grid_pixels(const Image& image) {
-  int n = 0;
-  for (std::size_t i = 0; i < static_cast<std::size_t>(image.width()) * image.height(); ++i) {
-    const float* q = image.data() + i * 4;
-    if (q[0] > 0.5f && q[1] > 0.5f && q[2] < 0.35f) ++n;
-  }
-  return n;
-}
+using test::make_clip;
+using test::Mean;
+using test::mean_of;
 
 class PlayerWindowTest : public ::testing::Test {
  protected:
@@ -81,98 +35,12 @@ class PlayerWindowTest : public ::testing::Test {
   test::ScopedDisplay display_env_{xvfb_.display_name()};
   test::TempDir dir_;
 
-  // The small test panel on the HMZ-T1's signal, without sound or messages.
-  PlayerOptions silent_options() const {
-    PlayerOptions options;
-    options.profile = small_profile(dir_);
-    options.signal = *find_signal("hdmi-fp-720p60");
-    options.audio = false;
-    options.quiet = true;
-    return options;
-  }
+  PlayerOptions silent_options() const { return test::silent_options(dir_); }
   // A window showing the packed frame of `options`' 160x90 panel.
   static std::unique_ptr<Display> open_display(const PlayerOptions& options) {
-    DisplayOptions display_options;
-    display_options.signal = options.signal;
-    display_options.packed = {options.signal.packed_width(160), options.signal.packed_height(90)};
-    return open_window_display(display_options, WindowMode::window);
+    return open_window_display(test::small_panel_display_options(options), WindowMode::window);
   }
 };
-
-TEST_F(PlayerWindowTest, PlaysTheClipInThePackedLayoutWithEachEyesContentAndFramesAdvance) {
-  const auto clip = make_clip(dir_);
-  PlayerOptions options = silent_options();
-
-  auto display = open_display(options);
-
-  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
-  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
-  ASSERT_LT(left.y + left.height, right.y);  // frame packing: a gap between the eyes
-  struct Seen {
-    double pts;
-    Mean left, right, gap, left_margin;
-    std::vector<float> left_pixels;
-  };
-  std::vector<Seen> seen;
-  options.after_render = [&](const Display& d, double pts) {
-    const auto panel = [&](const EyeArea& a) {
-      return read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90);
-    };
-    const Image l = panel(left);
-    const Image r = panel(right);
-    const Image gap = read_back(d.packed_framebuffer(), 0, left.y + left.height, 1280, right.y - left.y - left.height);
-    const Image margin = read_back(d.packed_framebuffer(), left.x, left.y, 400, 200);  // eye area outside the panel
-    seen.push_back({pts, mean_of(l), mean_of(r), mean_of(gap), mean_of(margin),
-                    std::vector<float>(l.data(), l.data() + static_cast<std::size_t>(l.width()) * l.height() * 4)});
-  };
-
-  auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
-  const PlayResult result = play(*display, *source, options);
-  EXPECT_EQ(result.end, PlayEnd::end_of_file);
-  ASSERT_GE(seen.size(), 5u) << "too few frames rendered";
-  EXPECT_EQ(result.counters.shown + result.counters.dropped, 60);
-  EXPECT_EQ(static_cast<std::int64_t>(seen.size()), result.counters.shown);
-
-  std::set<std::vector<float>> distinct;
-  for (std::size_t i = 0; i < seen.size(); ++i) {
-    const Seen& s = seen[i];
-    SCOPED_TRACE("frame at " + std::to_string(s.pts));
-    EXPECT_GT(s.left.r, s.left.b + 0.2);    // the left eye shows the red-ish view
-    EXPECT_GT(s.right.b, s.right.r + 0.2);  // the right eye the blue-ish one
-    EXPECT_LT(s.gap.max, 0.01);             // the frame-packing gap is black
-    EXPECT_LT(s.left_margin.max, 0.01);     // outside the panel: black
-    if (i > 0) {
-      EXPECT_GT(s.pts, seen[i - 1].pts);
-    }
-    distinct.insert(s.left_pixels);
-  }
-  // The moving box: every rendered frame looks different.
-  EXPECT_EQ(distinct.size(), seen.size());
-  EXPECT_NEAR(seen.back().pts, 59 / 30.0, 0.5);
-}
-
-TEST_F(PlayerWindowTest, SwapEyesPutsTheFirstStoredViewOnTheRight) {
-  const auto clip = make_clip(dir_);
-  PlayerOptions options = silent_options();
-  auto display = open_display(options);
-  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
-  std::vector<Mean> left_means;
-  options.after_render = [&](const Display& d, double) {
-    left_means.push_back(mean_of(read_back(d.packed_framebuffer(), left.x + 560, left.y + 315, 160, 90)));
-  };
-  std::atomic<bool> stop{false};
-  auto source = open_source(SourceRequest{clip.string(), "", StereoLayout::sbs, true, std::nullopt, true, false});
-  // Stop after a few frames: this test is about the routing only.
-  auto original = options.after_render;
-  options.after_render = [&](const Display& d, double pts) {
-    original(d, pts);
-    if (left_means.size() >= 3) stop = true;
-  };
-  const PlayResult result = play(*display, *source, options, &stop);
-  EXPECT_EQ(result.end, PlayEnd::interrupted);
-  ASSERT_FALSE(left_means.empty());
-  for (const Mean& m : left_means) EXPECT_GT(m.b, m.r + 0.2);
-}
 
 TEST_F(PlayerWindowTest, ClosingTheWindowEndsPlaybackCleanly) {
   const auto clip = make_clip(dir_);
@@ -190,7 +58,7 @@ TEST_F(PlayerWindowTest, ClosingTheWindowEndsPlaybackCleanly) {
 }
 
 // A stereo photo plays as its one frame, read as convert reads it (the still driver): a JPS (right
-// view first) and an MPO (two JPEGs) both show the left view to the left eye.
+// view first) and an MPO (two JPEGs) both show the left view to the left eye, in the window too.
 TEST_F(PlayerWindowTest, AStereoPhotoShowsEachEyesView) {
   const Image red = test::filled_image(320, 180, {0.75f, 0.2f, 0.1f, 1.f});
   const Image blue = test::filled_image(320, 180, {0.1f, 0.25f, 0.75f, 1.f});
@@ -229,323 +97,14 @@ TEST_F(PlayerWindowTest, AStereoPhotoShowsEachEyesView) {
     ASSERT_EQ(seen.size(), 1u);
     EXPECT_GT(seen[0].first.r, seen[0].first.b + 0.2);
     EXPECT_GT(seen[0].second.b, seen[0].second.r + 0.2);
+    // And the window shows that frame (1:1: the screen has room for it), as the X server draws it.
+    const test::WindowCapture screen = test::capture_window(glfwGetCurrentContext());
+    ASSERT_EQ(screen.width, 1280);
+    ASSERT_EQ(screen.height, 1470);
+    const auto centre = [&](const EyeArea& a) { return screen.at(a.x + a.width / 2, a.y + a.height / 2); };
+    EXPECT_GT(centre(left)[0], centre(left)[2] + 50);
+    EXPECT_GT(centre(right)[2], centre(right)[0] + 50);
   }
-}
-
-// A source that records the block of each frame it hands out; with `allow_reduction` false it
-// refuses every view format but whole views (as before the player asked for block means).
-class RecordingSource final : public Source {
- public:
-  RecordingSource(std::unique_ptr<Source> inner, bool allow_reduction)
-      : inner_(std::move(inner)), allow_(allow_reduction) {}
-  std::optional<StereoVideoFrame> next() override {
-    auto f = inner_->next();
-    if (f) blocks.push_back(f->block);
-    return f;
-  }
-  SourceInfo info() const override { return inner_->info(); }
-  void seek(double seconds) override { inner_->seek(seconds); }
-  ViewFormat negotiate(const ViewFormat& wanted) override { return allow_ ? inner_->negotiate(wanted) : ViewFormat{}; }
-  std::vector<std::array<int, 2>> blocks;
-
- private:
-  std::unique_ptr<Source> inner_;
-  bool allow_;
-};
-
-TEST_F(PlayerWindowTest, PlaysFromTheCompositorsBlockMeansWithTheSameImageAsFromWholeViews) {
-  const auto clip = make_clip(dir_);
-  PlayerOptions options = silent_options();
-  const auto wanted = stereo_prefilter_block(options.profile, options.compositor, 320, 180, 0.0);
-  ASSERT_TRUE(wanted[0] > 1 || wanted[1] > 1) << "the test profile should make the compositor average blocks";
-  auto display = open_display(options);
-  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
-  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
-
-  // The first frame, played once from block means and once from whole views.
-  std::vector<Image> shown;
-  std::atomic<bool> stop{false};
-  options.after_render = [&](const Display& d, double) {
-    shown.push_back(read_back(d.packed_framebuffer(), 0, 0, d.packed_size()[0], d.packed_size()[1]));
-    stop = true;
-  };
-  std::vector<std::array<int, 2>> blocks[2];
-  for (bool reduce : {true, false}) {
-    stop = false;
-    RecordingSource source(
-        open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false}), reduce);
-    play(*display, source, options, &stop);
-    blocks[reduce ? 0 : 1] = source.blocks;
-  }
-  ASSERT_EQ(shown.size(), 2u);
-  ASSERT_FALSE(blocks[0].empty());
-  for (const auto& b : blocks[0]) EXPECT_EQ(b, wanted);
-  for (const auto& b : blocks[1]) EXPECT_EQ(b, (std::array<int, 2>{1, 1}));
-  // Same picture in both eyes' panels (rounding-level differences only).
-  for (const EyeArea& a : {left, right}) {
-    double sum = 0.0, worst = 0.0;
-    const int x0 = a.x + (a.width - 160) / 2, y0 = a.y + (a.height - 90) / 2;
-    for (int y = y0; y < y0 + 90; ++y)
-      for (int x = x0; x < x0 + 160; ++x)
-        for (int c = 0; c < 3; ++c) {
-          const std::size_t i = (static_cast<std::size_t>(y) * shown[0].width() + x) * 4 + c;
-          const double d = std::abs(shown[0].data()[i] - shown[1].data()[i]);
-          sum += d;
-          worst = std::max(worst, d);
-        }
-    EXPECT_LT(sum / (160.0 * 90 * 3), 0.01);
-    EXPECT_LT(worst, 0.15);
-  }
-}
-
-// Sets an environment variable for a scope, restoring what was there before.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    setenv(name, value, 1);
-  }
-  ~ScopedEnv() {
-    if (old_)
-      setenv(name_.c_str(), old_->c_str(), 1);
-    else
-      unsetenv(name_.c_str());
-  }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  std::string name_;
-  std::optional<std::string> old_;
-};
-
-TEST_F(PlayerWindowTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessagesStillShow) {
-  // On software GL the player composites 8-bit block means on the CPU from composite tables and
-  // uploads the packed frame; NELF_COMPOSITE picks either path. The same clip played both ways,
-  // with 's' and 'c' pressed at 1 s: their message (2 s) is drawn with GL onto the view textures
-  // in the GL run and into the views' bytes in the table run (TextOverlay::cover), eyes swapped
-  // and the calibration grid drawn into the views' bytes too. Every frame both runs rendered (by
-  // pts: a loaded machine may drop different ones) looks the same, text and grid included. The
-  // table run's frames are mostly composited ahead, on a worker (compositor/cpu/composite_ahead).
-  const auto clip = make_clip(dir_, 4);
-  PlayerOptions options = silent_options();
-  const auto wanted = stereo_prefilter_block(options.profile, options.compositor, 320, 180, 0.0);
-  ASSERT_TRUE(wanted[0] > 1 || wanted[1] > 1) << "the table needs block means";
-  auto display = open_display(options);
-  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
-  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
-  const auto panel = [](const Display& d, const EyeArea& a) {
-    return read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90);
-  };
-  struct Frame {
-    Image left, right;
-    Mean gap;
-  };
-  std::map<double, Frame> shown[2];  // [0]: table, [1]: gl
-  for (int path : {0, 1}) {
-    const ScopedEnv composite("NELF_COMPOSITE", path == 0 ? "table" : "gl");
-    bool pressed = false;
-    options.after_render = [&](const Display& d, double pts) {
-      // A redraw of the same pts (the message's) replaces the frame.
-      shown[path][pts] = Frame{
-          panel(d, left), panel(d, right),
-          mean_of(read_back(d.packed_framebuffer(), 0, left.y + left.height, 1280, right.y - left.y - left.height))};
-      if (!pressed && pts >= 1.0) {
-        test::send_key(glfwGetCurrentContext(), "s");
-        test::send_key(glfwGetCurrentContext(), "c");
-        pressed = true;
-      }
-    };
-    auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
-    const PlayResult result = play(*display, *source, options);
-    EXPECT_EQ(result.end, PlayEnd::end_of_file);
-    ASSERT_TRUE(pressed);
-    // The table run shows most frames as composited ahead on the worker (the frames compared
-    // below are mostly those), the GL run none.
-    if (path == 0) {
-      EXPECT_GE(result.composited_ahead, 20);
-    } else {
-      EXPECT_EQ(result.composited_ahead, 0);
-    }
-  }
-  // The keys arrive with some later poll: the first frame with the blue view on the left or the
-  // grid is where each run took them (and said so).
-  double keys_at[2] = {0.0, 0.0};
-  for (int path : {0, 1}) {
-    const auto changed = std::find_if(shown[path].begin(), shown[path].end(), [](const auto& f) {
-      const Mean l = mean_of(f.second.left);
-      return l.b > l.r || grid_pixels(f.second.left) > 0;
-    });
-    ASSERT_NE(changed, shown[path].end()) << "'s' and 'c' changed nothing";
-    keys_at[path] = changed->first;
-  }
-  // Before the keys: the table; after them, while the message surely shows: GL with text in both
-  // runs; once it has surely gone: the table, eyes swapped, grid on. Frames between the two runs'
-  // keys (and a margin for 'c' coming a poll after 's'), or around the message's end, may differ
-  // in what they show, and are skipped.
-  const double first_key = std::min(keys_at[0], keys_at[1]);
-  const double last_key = std::max(keys_at[0], keys_at[1]);
-  int before = 0, message = 0, after = 0;
-  for (const auto& [pts, table] : shown[0]) {
-    const auto gl = shown[1].find(pts);
-    if (gl == shown[1].end()) continue;
-    if (pts < first_key)
-      ++before;
-    else if (pts >= last_key + 0.3 && pts < first_key + 1.5)
-      ++message;
-    else if (pts >= last_key + 2.5)
-      ++after;
-    else
-      continue;
-    SCOPED_TRACE("frame at " + std::to_string(pts));
-    if (pts < first_key) {
-      const Mean l = mean_of(table.left), r = mean_of(table.right);
-      EXPECT_GT(l.r, l.b + 0.2);  // not black: each eye its own view
-      EXPECT_GT(r.b, r.r + 0.2);
-      EXPECT_EQ(grid_pixels(table.left) + grid_pixels(table.right), 0);
-    } else {
-      EXPECT_GT(grid_pixels(table.left), 500);  // the grid on the table path too
-      EXPECT_GT(grid_pixels(table.right), 500);
-      const Mean l = mean_of(table.left), r = mean_of(table.right);
-      EXPECT_GT(r.r - r.b, l.r - l.b + 0.15);  // swapped: the red-ish view now on the right
-    }
-    EXPECT_LT(table.gap.max, 0.01);  // the frame-packing gap black on the CPU path too
-    for (const auto& [a, b] : {std::pair{&table.left, &gl->second.left}, {&table.right, &gl->second.right}}) {
-      double sum = 0.0, worst = 0.0;
-      const std::size_t n = static_cast<std::size_t>(a->width()) * a->height();
-      for (std::size_t i = 0; i < n; ++i)
-        for (int c = 0; c < 4; ++c) {  // alpha too: the CPU path writes it opaque, as GL does
-          const double d = std::abs(a->data()[i * 4 + c] - b->data()[i * 4 + c]);
-          sum += d;
-          worst = std::max(worst, d);
-        }
-      EXPECT_LT(sum / (4.0 * n), 1.0 / 255);  // the table agrees with GL to a code value or two
-      EXPECT_LT(worst, 4.5 / 255);            // and the text box shows on both (far more than that)
-    }
-  }
-  const std::string why = fmt::format("{} frames in the table run, {} in the GL run; keys taken at {} and {} s",
-                                      shown[0].size(), shown[1].size(), keys_at[0], keys_at[1]);
-  EXPECT_GE(before, 5) << why;
-  EXPECT_GE(message, 5) << why;
-  EXPECT_GE(after, 5) << why;
-}
-
-// The window, with keys the test types itself: they come with the player's next poll, so the frame
-// rendered after the one a key was typed at is the first one the key may change (keys sent through
-// the X server may take a few polls to arrive).
-class TypedKeysDisplay final : public Display {
- public:
-  explicit TypedKeysDisplay(std::unique_ptr<Display> inner) : inner_(std::move(inner)) {}
-  void type(KeyPress key) { typed_.push_back(key); }
-
-  std::shared_ptr<gl::Context> context() const override { return inner_->context(); }
-  GLuint packed_framebuffer() const override { return inner_->packed_framebuffer(); }
-  GLuint packed_texture() const override { return inner_->packed_texture(); }
-  std::array<int, 2> packed_size() const override { return inner_->packed_size(); }
-  void present() override { inner_->present(); }
-  double refresh_hz() const override { return inner_->refresh_hz(); }
-  bool vsync() const override { return inner_->vsync(); }
-  std::vector<KeyPress> poll_events() override {
-    std::vector<KeyPress> keys = inner_->poll_events();
-    keys.insert(keys.end(), typed_.begin(), typed_.end());
-    typed_.clear();
-    return keys;
-  }
-  bool close_requested() const override { return inner_->close_requested(); }
-  std::string description() const override { return inner_->description(); }
-
- private:
-  std::unique_ptr<Display> inner_;
-  std::vector<KeyPress> typed_;
-};
-
-TEST_F(PlayerWindowTest, NoFrameCompositedAheadShowsAStateAKeyHasChanged) {
-  // On the CPU path a worker composites the next queued frames ahead (compositor/cpu/composite_ahead)
-  // with the state of the moment; a key changes that state while such frames wait. Without
-  // on-screen messages (while one shows, GL draws the frames) the table path goes on right after
-  // the key, so a frame made before it would be seen at once. The clip played on the table path
-  // and on GL, keys typed during both: 's' (swap eyes), 'c' (calibration grid, drawn into the
-  // views), ']' (IPD: new tables for the same views), ← (seek back to the start). Every frame shown
-  // after a key has its effect, and each frame both runs rendered in the same state (keys typed
-  // before it, pts) looks the same. The GL run takes each key 0.3 s earlier, so that the table
-  // run's frames right after its keys, where a stale frame would be, have GL frames to match.
-  const auto clip = make_clip(dir_, 4);
-  PlayerOptions options = silent_options();
-  options.on_screen_messages = false;
-  const auto wanted = stereo_prefilter_block(options.profile, options.compositor, 320, 180, 0.0);
-  ASSERT_TRUE(wanted[0] > 1 || wanted[1] > 1) << "the table needs block means";
-  TypedKeysDisplay display(open_display(options));
-  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
-  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
-  const auto panel = [](const Display& d, const EyeArea& a) {
-    return read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90);
-  };
-  const std::vector<std::pair<double, KeyPress>> keys = {{0.8, KeyPress::of(U's')},
-                                                         {1.4, KeyPress::of(U'c')},
-                                                         {2.0, KeyPress::of(U']')},
-                                                         {2.6, KeyPress::of(KeyPress::Named::left)}};
-  struct Frame {
-    Image left, right;
-  };
-  // [0]: table, [1]: gl; by (keys typed before the frame was rendered, pts).
-  std::map<std::pair<std::size_t, double>, Frame> shown[2];
-  PlayResult results[2];
-  for (int path : {0, 1}) {
-    const ScopedEnv composite("NELF_COMPOSITE", path == 0 ? "table" : "gl");
-    const double lead = path == 1 ? 0.3 : 0.0;
-    std::size_t typed = 0;
-    options.after_render = [&](const Display& d, double pts) {
-      shown[path][{typed, pts}] = Frame{panel(d, left), panel(d, right)};
-      if (typed < keys.size() && pts >= keys[typed].first - lead) display.type(keys[typed++].second);
-    };
-    auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
-    results[path] = play(display, *source, options);
-    EXPECT_EQ(results[path].end, PlayEnd::end_of_file);
-    ASSERT_EQ(typed, keys.size());
-  }
-  // Most frames of the table run came from the worker, none of the GL run's.
-  EXPECT_GE(results[0].composited_ahead * 2, results[0].counters.shown)
-      << results[0].composited_ahead << " of " << results[0].counters.shown;
-  EXPECT_EQ(results[1].composited_ahead, 0);
-
-  std::map<std::size_t, int> compared;
-  int after_seek = 0;
-  for (const auto& [key, table] : shown[0]) {
-    const auto& [typed, pts] = key;
-    SCOPED_TRACE(fmt::format("table frame at {} s after {} keys", pts, typed));
-    const Mean l = mean_of(table.left), r = mean_of(table.right);
-    if (typed == 0) {
-      EXPECT_GT(l.r, l.b + 0.2);  // each eye its own view
-      EXPECT_GT(r.b, r.r + 0.2);
-    } else {
-      EXPECT_GT(r.r - r.b, l.r - l.b + 0.15);  // swapped: the red-ish view on the right
-    }
-    if (typed >= 2) {
-      EXPECT_GT(grid_pixels(table.left), 500);
-      EXPECT_GT(grid_pixels(table.right), 500);
-    } else {
-      EXPECT_EQ(grid_pixels(table.left) + grid_pixels(table.right), 0);
-    }
-    if (typed == 4 && pts < keys[3].first - 0.5) ++after_seek;
-    const auto gl = shown[1].find(key);
-    if (gl == shown[1].end()) continue;
-    ++compared[typed];
-    for (const auto& [a, b] : {std::pair{&table.left, &gl->second.left}, {&table.right, &gl->second.right}}) {
-      double sum = 0.0, worst = 0.0;
-      const std::size_t n = static_cast<std::size_t>(a->width()) * a->height();
-      for (std::size_t i = 0; i < n; ++i)
-        for (int c = 0; c < 4; ++c) {
-          const double d = std::abs(a->data()[i * 4 + c] - b->data()[i * 4 + c]);
-          sum += d;
-          worst = std::max(worst, d);
-        }
-      EXPECT_LT(sum / (4.0 * n), 1.0 / 255);
-      EXPECT_LT(worst, 4.5 / 255);
-    }
-  }
-  EXPECT_GE(after_seek, 20) << "the seek back did not show the start again";
-  for (std::size_t typed = 0; typed <= keys.size(); ++typed)
-    EXPECT_GE(compared[typed], 5) << "too few frames in the same state in both runs after " << typed << " keys";
 }
 
 }  // namespace

@@ -1,0 +1,134 @@
+#include "player/play_session.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+
+#include "core/image_library.hpp"
+#include "core/user_error.hpp"
+#include "player/key_bindings.hpp"
+
+namespace nelf::playback {
+
+namespace {
+
+// The on-screen messages draw their text with OpenImageIO, loaded on first use: load it now
+// (~0.3 s) rather than as a hitch at the first key press. Without it the film still plays; the
+// first message then stops play with the same error, as a missing font would.
+PackedLayout prepared_layout(Display& display, const PlayerOptions& options) {
+  try {
+    image_library::preload();
+  } catch (const image_library::ImageLibraryError& e) {
+    std::fprintf(stderr, "nelf: warning: %s\n", e.what());
+  }
+  display.context()->make_current();
+  return packed_layout(options.signal, options.profile.display.resolution);
+}
+
+// The display's packed frame, once both eyes are known to fit it; the compositor gets the grid.
+GlPackedTarget checked_target(const Display& display, FrameCompositor& compositor, const PackedLayout& layout,
+                              const PlayerOptions& options) {
+  require_eyes_fit(layout, options.profile.name, options.signal.name);
+  const std::array<int, 2> packed = display.packed_size();
+  for (const auto& origin : layout.origins)
+    if (origin && (origin->first + layout.eye[0] > packed[0] || origin->second + layout.eye[1] > packed[1]))
+      throw UserError(fmt::format("the display's {}x{} frame is smaller than signal {} needs", packed[0], packed[1],
+                                  options.signal.name),
+                      1);
+  compositor.set_grid_pattern(calibration_grid_pattern());
+  return GlPackedTarget{display.packed_framebuffer(), display.packed_texture(), packed};
+}
+
+// The master clock: the sound's when there is sound (the tests' stepped clock when they give one). It starts with the
+// first frame on screen.
+PlaybackClock& paused_master_clock(PlaySound& sound, const PlayerOptions& options) {
+  if (!options.quiet)
+    std::fprintf(stderr, sound.playing() ? "nelf: sound: %s\n" : "nelf: %s: playing without sound\n",
+                 sound.description().c_str());
+  PlaybackClock& clock = options.clock ? *options.clock : sound.clock();
+  clock.set_paused(true);
+  return clock;
+}
+
+}  // namespace
+
+PlaySession::PlaySession(Display& display_, Source& source_, const PlayerOptions& options_,
+                         const std::atomic<bool>* stop_)
+    : display(display_),
+      source(source_),
+      options(options_),
+      stop(stop_),
+      layout(prepared_layout(display, options)),
+      compositor(options.profile, options.compositor, layout, display.context()),
+      target(checked_target(display, compositor, layout, options)),
+      log(options.log_frames),
+      sound(source, options),
+      clock(paused_master_clock(sound, options)),
+      refresh_period(1.0 / display.refresh_hz()),
+      info(source.info()),
+      scheduler(refresh_period, info.frame_rate > 0 ? 1.0 / info.frame_rate : 0.0),
+      view_format(source.negotiate(compositor.wanted_view_format(info.view))),
+      queue(queue_capacity),
+      decoder([this] { decode_loop(source, queue); }),
+      commands(state, display, compositor, queue, sound, scheduler, options, info.duration_s, info.view),
+      render_time(refresh_period),
+      ticker(refresh_period) {}
+
+void PlaySession::wait_for_first_frame() {
+  while (!queue.wait_for_frame(std::chrono::milliseconds(50))) {
+    bool end = false;
+    queue.snapshot(end);
+    if (end || (stop && stop->load()) || display.close_requested()) break;
+    display.poll_events();
+  }
+}
+
+std::optional<PlayEnd> PlaySession::take_keys_and_events() {
+  bool quit = false;
+  for (const KeyPress& key : display.poll_events())
+    if (const std::optional<Command> command = command_for(KeyScope::play, key))
+      if (!commands.apply(*command)) quit = true;
+  if (quit) return PlayEnd::quit_key;
+  if (display.close_requested()) return PlayEnd::window_closed;
+  if (stop && stop->load()) return PlayEnd::interrupted;
+  return std::nullopt;
+}
+
+// Before the clock starts (after the first frame) or restarts (after a seek): the next frames
+// composited ahead, waiting up to 0.3 s. The worker's first frames take 40 ms and more (new
+// buffers, cold caches), and with the clock running the first refreshes dropped frames waiting
+// for them (2 of 300 at 30 fps in a run of tests/bench/play_pacing.sh).
+void PlaySession::start_clock() {
+  compositor.composite_ahead(queue.front(queue_capacity), commands.overlays(), target);
+  compositor.wait_for_ahead(std::chrono::milliseconds(300));
+  clock.set_paused(false);
+}
+
+// After the next vblank, or once rendered and presented (at once on a stepped clock).
+double PlaySession::seen_after() const {
+  if (options.clock) return 0.0;
+  return display.vsync() ? refresh_period : render_time.median_s();
+}
+
+void PlaySession::wait_for_next_refresh() {
+  if (options.clock)
+    options.clock->advance(refresh_period);
+  else if (!display.vsync())
+    ticker.sleep_to_next();
+}
+
+PlayResult PlaySession::finish(std::int64_t composited_ahead) {
+  queue.stop();
+  decoder.join();
+  PlayResult result;
+  result.had_sound = sound.playing();
+  result.sound = sound.description();
+  result.audio_decode_errors = sound.decode_errors();
+  sound.stop();
+  result.counters = scheduler.counters();
+  result.video_decode_errors = source.lost_frames();
+  result.composited_ahead = composited_ahead;
+  return result;
+}
+
+}  // namespace nelf::playback
