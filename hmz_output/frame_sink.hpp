@@ -1,7 +1,7 @@
 #pragma once
 // Where `nelf convert` sends its packed frames, one after the other: an encoded video file, an image
 // sequence, one image, or raw RGBA on stdout. Chosen by the output name, one row each in the
-// table of hmz_output/file_sink_drivers.cpp. A sink destroyed before finish() leaves nothing behind.
+// table of hmz_output/output_drivers.cpp. A sink destroyed before finish() leaves nothing behind.
 #include <functional>
 #include <memory>
 #include <optional>
@@ -10,18 +10,20 @@
 #include "core/audio_stream.hpp"
 #include "core/carried_streams.hpp"
 #include "core/frames.hpp"
+#include "hmz_output/sink.hpp"
 #include "hmz_output/video_encoder.hpp"
 
 namespace nelf {
 
-class FrameSink {
+class FrameSink : public Sink {
  public:
-  virtual ~FrameSink() = default;
   virtual void write(const PackedFrame& frame) = 0;
   // Everything written is complete and in place.
-  virtual void finish() = 0;
+  void finish() override = 0;
   // What was written, for the last line: "out.mkv", "raw video to stdout".
-  virtual std::string description() const = 0;
+  std::string description() const override = 0;
+  // Untimed: frames are written as fast as they are composited.
+  double refresh_hz() const override { return 0.0; }
 };
 
 // What a file sink is opened with, once the packed frame's size is known.
@@ -33,7 +35,7 @@ struct FrameSinkRequest {
   EncoderSettings encoder;           // codec, quality, -y, audio wanted
   std::optional<double> duration_s;  // --duration: carried streams end there at the latest
   // The source's own streams (a file's audio, subtitles, chapters), else its decoded sound; only
-  // for a row that carries streams (FileSinkDriver::carries_streams), null when there are none.
+  // for a row that carries streams (OutputDriver::carries_streams), null when there are none.
   std::unique_ptr<CarriedStreams> carried;
   std::unique_ptr<AudioStream> audio;
   // Throws (UserError, status 2) when a file name is one of the inputs: every frame of an image

@@ -101,7 +101,7 @@ std::unique_ptr<FrameSink> open_frame_sink(const VideoConvertRequest& r, Source&
   }
   request.refuse_as_output = [&inputs = r.inputs](const std::string& name) { inputs.refuse_as_output(name); };
   request.raw_fd = STDOUT_FILENO;
-  return driver.open(std::move(request));
+  return driver.open_file(std::move(request));
 }
 
 }  // namespace

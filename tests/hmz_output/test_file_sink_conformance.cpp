@@ -1,5 +1,5 @@
-// The contract of every file sink (hmz_output/frame_sink.hpp), run over every row of the table in
-// hmz_output/file_sink_drivers.cpp: N frames written then finish() leave an output holding N
+// The contract of every file sink (hmz_output/frame_sink.hpp), run over every file row of the
+// table in hmz_output/output_drivers.cpp: N frames written then finish() leave an output holding N
 // frames; a sink destroyed before finish() leaves nothing behind; description() names the output.
 // A row is covered by giving it a case maker below; a row without one fails the suite.
 #include <fcntl.h>
@@ -14,7 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "hmz_output/display_drivers.hpp"
 #include "hmz_output/file_sink_drivers.hpp"
+#include "hmz_output/sink.hpp"
 #include "support/image_files.hpp"
 #include "support/test_support.hpp"
 
@@ -166,7 +168,7 @@ std::unique_ptr<FrameSink> open_case(const FileSinkDriver& row, const SinkCase& 
   request.bits = c.bits;
   request.frame_rate = kRate;
   request.raw_fd = c.raw_fd;
-  return row.open(std::move(request));
+  return row.open_file(std::move(request));
 }
 
 // Runs `check` on each case of every row, in a fresh directory each; a row without cases fails.
@@ -222,9 +224,37 @@ TEST(FileSinkConformance, UnfinishedSinkLeavesNothingBehind) {
 
 TEST(FileSinkConformance, DescriptionNamesTheOutput) {
   for_every_case([](const FileSinkDriver& row, const SinkCase& c, const TempDir&) {
-    const auto sink = open_case(row, c);
+    const std::unique_ptr<Sink> sink = open_case(row, c);
     EXPECT_NE(sink->description().find(c.described_as), std::string::npos) << sink->description();
+    EXPECT_EQ(sink->refresh_hz(), 0.0);  // untimed
   });
+}
+
+// One table of all outputs: the live rows open displays, the file rows sinks, and the two views
+// of it (--output of play and calibrate, convert's choice by name) are its two parts.
+TEST(FileSinkConformance, TheFileRowsAreTheTablesRowsThatAreNotLive) {
+  const auto all = output_drivers();
+  const auto live = display_drivers();
+  const auto files = file_sink_drivers();
+  ASSERT_EQ(live.size() + files.size(), all.size());
+  EXPECT_EQ(live.data(), all.data());
+  EXPECT_EQ(files.data(), all.data() + live.size());
+  for (const OutputDriver& row : live) {
+    SCOPED_TRACE(std::string(row.name));
+    EXPECT_TRUE(row.live);
+    EXPECT_NE(row.open_display, nullptr);
+    EXPECT_EQ(row.open_file, nullptr);
+    EXPECT_EQ(find_display_driver(row.name), &row);
+  }
+  for (const OutputDriver& row : files) {
+    SCOPED_TRACE(std::string(row.name));
+    EXPECT_FALSE(row.live);
+    EXPECT_NE(row.accepts, nullptr);
+    EXPECT_NE(row.open_file, nullptr);
+    EXPECT_EQ(row.open_display, nullptr);
+    EXPECT_EQ(find_display_driver(row.name), nullptr);  // play --output raw stays unknown
+  }
+  EXPECT_EQ(display_driver_names(), "window, fullscreen, kms, quad-buffer or offscreen");
 }
 
 // The sequence's own check: a frame whose name is an input is refused before it is written.
@@ -240,7 +270,7 @@ TEST(FileSinkConformance, ImageSequenceAsksBeforeEachFrame) {
     asked.push_back(std::filesystem::path(name).filename().string());
     if (asked.size() == 2) throw std::runtime_error("an input");
   };
-  auto sink = file_sink_driver_for(request.output).open(std::move(request));
+  auto sink = file_sink_driver_for(request.output).open_file(std::move(request));
   sink->write(packed_frame(8, 0));
   EXPECT_THROW(sink->write(packed_frame(8, 1)), std::runtime_error);
   EXPECT_EQ(asked, (std::vector<std::string>{"f_1.png", "f_2.png"}));
