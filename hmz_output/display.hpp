@@ -4,7 +4,7 @@
 // into the display's packed framebuffer (GlCompositor::render_eye at the eye areas of
 // hmz_output/packing), or (`nelf play` on software GL) on the CPU from composite tables into its
 // texture, then call present(). Each kind of display is its own file (window_display.*,
-// kms_display.*, offscreen_display.cpp) and one row of the table in display_drivers.cpp; this
+// kms_display.*, offscreen_display.cpp) and one live row of the table in output_drivers.cpp; this
 // header is the contract between them and the player.
 #include <epoxy/gl.h>
 
