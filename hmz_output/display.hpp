@@ -4,7 +4,7 @@
 // into the display's packed framebuffer (GlCompositor::render_eye at the eye areas of
 // hmz_output/packing), or (`nelf play` on software GL) on the CPU from composite tables into its
 // texture, then call present(). Each kind of display is its own file (window_display.*,
-// kms_display.*, offscreen_display.cpp) and one row of the table in display_drivers.cpp; this
+// kms_display.*, offscreen_display.cpp) and one live row of the table in output_drivers.cpp; this
 // header is the contract between them and the player.
 #include <epoxy/gl.h>
 
@@ -17,6 +17,7 @@
 #include "core/gl/context.hpp"
 #include "core/keys.hpp"
 #include "hmz_output/signal.hpp"
+#include "hmz_output/sink.hpp"
 
 namespace nelf {
 
@@ -30,10 +31,8 @@ struct DisplayOptions {
   std::optional<int> gpu;       // offscreen: the EGL device (--gpu; unset: NELF_GPU, else the first hardware one)
 };
 
-class Display {
+class Display : public Sink {
  public:
-  virtual ~Display() = default;
-
   // The display's GL 4.5 core context, current on the thread that opened the display; give it to
   // GlCompositor so that render_eye() can draw into packed_framebuffer().
   virtual std::shared_ptr<gl::Context> context() const = 0;
@@ -51,7 +50,7 @@ class Display {
   // the next vertical blank when vsync() is true. Throws std::runtime_error when the output is lost.
   virtual void present() = 0;
   // The refresh rate frames are paced at (the signal's, or the monitor's when it reports one).
-  virtual double refresh_hz() const = 0;
+  double refresh_hz() const override = 0;
   // True when present() waits for vblank; otherwise the caller paces frames with a timer.
   virtual bool vsync() const = 0;
 
@@ -65,7 +64,7 @@ class Display {
 
   // One line for logs, e.g. "window 1280x1470 on :99 (llvmpipe, no vsync)" or
   // "KMS HDMI-A-1 1280x1470@60Hz 3D frame packing".
-  virtual std::string description() const = 0;
+  std::string description() const override = 0;
 };
 
 }  // namespace nelf

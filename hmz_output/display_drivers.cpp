@@ -2,36 +2,19 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <stdexcept>
-
-#include "hmz_output/kms_display.hpp"
-#include "hmz_output/window_display.hpp"
 
 namespace nelf {
 
-// Outputs that are one file with no header of their own declare their opener here, beside their row.
-std::unique_ptr<Display> open_offscreen_display(const DisplayOptions& options);
-std::unique_ptr<Display> open_quad_buffer_display(const DisplayOptions& options);
-
-namespace {
-
-constexpr DisplayDriver kDrivers[] = {
-    {"window", "a desktop window, the packed frame scaled to fit",
-     [](const DisplayOptions& o) { return open_window_display(o, WindowMode::window); }},
-    {"fullscreen", "1:1 on the monitor --monitor names, the HMD by default",
-     [](const DisplayOptions& o) { return open_window_display(o, WindowMode::fullscreen); }},
-    {"kms", "scan-out on the --connector without a desktop (docs/kms.md)", open_kms_display},
-    {"quad-buffer", "an OpenGL quad-buffer stereo window, an eye in each back buffer", open_quad_buffer_display},
-    {"offscreen", "no display: rendered off screen and paced by the clock, for tests and timing",
-     open_offscreen_display},
-};
-
-}  // namespace
-
-std::span<const DisplayDriver> display_drivers() { return kDrivers; }
+std::span<const DisplayDriver> display_drivers() {
+  const auto all = output_drivers();
+  const auto first_file = std::find_if(all.begin(), all.end(), [](const OutputDriver& d) { return !d.live; });
+  return all.first(static_cast<std::size_t>(first_file - all.begin()));
+}
 
 const DisplayDriver* find_display_driver(std::string_view name) {
-  for (const DisplayDriver& driver : kDrivers)
+  for (const DisplayDriver& driver : display_drivers())
     if (driver.name == name) return &driver;
   return nullptr;
 }
@@ -43,17 +26,18 @@ const DisplayDriver& display_driver(std::string_view name) {
 
 std::string display_driver_names() {
   std::string names;
-  const std::size_t count = std::size(kDrivers);
+  const auto drivers = display_drivers();
+  const std::size_t count = drivers.size();
   for (std::size_t i = 0; i < count; ++i) {
     if (i > 0) names += i + 1 == count ? " or " : ", ";
-    names += kDrivers[i].name;
+    names += drivers[i].name;
   }
   return names;
 }
 
 std::string display_driver_help() {
   std::string help;
-  for (const DisplayDriver& driver : kDrivers) {
+  for (const DisplayDriver& driver : display_drivers()) {
     if (!help.empty()) help += "; ";
     help += fmt::format("{} ({})", driver.name, driver.help);
   }

@@ -1,23 +1,19 @@
 #pragma once
 // The live outputs `nelf play --output` and `nelf calibrate --output` choose from: one row each in
-// display_drivers.cpp. The option's help, its check and the "unknown output" error are made from
+// output_drivers.cpp. The option's help, its check and the "unknown output" error are made from
 // the table, so a new output is its own file plus one row.
 #include <memory>
 #include <span>
 #include <string>
 #include <string_view>
 
-#include "hmz_output/display.hpp"
+#include "hmz_output/output_drivers.hpp"
 
 namespace nelf {
 
-struct DisplayDriver {
-  std::string_view name;  // the --output value
-  std::string_view help;  // what it shows, a few words for --help
-  // Opens the display; throws std::runtime_error (one line) when it cannot.
-  std::unique_ptr<Display> (*open)(const DisplayOptions& options);
-};
+using DisplayDriver = OutputDriver;
 
+// The live rows of hmz_output/output_drivers.cpp.
 std::span<const DisplayDriver> display_drivers();
 
 // The driver called `name`, or nullptr.

@@ -65,4 +65,6 @@ std::unique_ptr<FrameSink> open_raw_frame_sink(int fd, int width, int height, do
   return std::make_unique<RawFrameSink>(fd, width, height, frame_rate);
 }
 
+bool is_raw_output(const std::string& output) { return output == "-"; }
+
 }  // namespace nelf

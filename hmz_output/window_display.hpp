@@ -8,7 +8,7 @@
 
 namespace nelf {
 
-// How a GLFW display shows the packed frame (each a row of display_drivers.cpp).
+// How a GLFW display shows the packed frame (each a row of output_drivers.cpp).
 enum class WindowMode { window, fullscreen };
 
 // Opens a display in `mode`; its context is current on

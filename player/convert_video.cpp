@@ -2,17 +2,14 @@
 #include "core/printable.hpp"
 
 #include <fmt/format.h>
-#include <fmt/printf.h>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
-#include <cstring>
 #include <exception>
 #include <future>
 #include <mutex>
-#include <regex>
 #include <thread>
 
 extern "C" {
@@ -25,8 +22,7 @@ extern "C" {
 #include "core/bounded_queue.hpp"
 #include "core/ffmpeg_raii.hpp"
 #include "core/user_error.hpp"
-#include "hmz_output/frame_sink.hpp"
-#include "hmz_output/image_sink.hpp"
+#include "hmz_output/file_sink_drivers.hpp"
 #include "hmz_output/packing.hpp"
 #include "inputs/source_drivers.hpp"
 #include "inputs/synthetic_source.hpp"
@@ -38,148 +34,6 @@ extern "C" {
 namespace nelf {
 
 namespace {
-
-// An encoded video file, with the source's own streams copied when it has them (a file's audio,
-// subtitles and chapters), else its decoded sound (the synthetic clip's tone) encoded.
-class EncodedFileSink final : public FrameSink {
- public:
-  EncodedFileSink(const VideoConvertRequest& r, std::unique_ptr<CarriedStreams> carried,
-                  std::unique_ptr<AudioStream> audio, int width, int height, int bits, double frame_rate)
-      : output_(r.output), frame_rate_(frame_rate), carried_(std::move(carried)), audio_(std::move(audio)) {
-    EncoderSettings settings = r.encoder;
-    settings.bits = bits;
-    const AVRational rate = av_d2q(frame_rate, 100000);
-    try {
-      encoder_.emplace(r.output, width, height, rate.num, rate.den, settings, carried_ ? &carried_->layout() : nullptr);
-    } catch (const std::invalid_argument& e) {
-      throw UserError(e.what(), 2);
-    } catch (const std::runtime_error& e) {
-      throw UserError(e.what(), 1);
-    }
-    if (audio_) encoder_->add_audio_track(audio_->sample_rate(), audio_->channels());
-    if (carried_) carried_indices_ = encoder_->carried_streams();
-    end_s_ = r.duration_s;
-  }
-  void write(const PackedFrame& frame) override {
-    encoder_->write_video(frame);
-    last_end_s_ = frame.pts_seconds + 1.0 / frame_rate_;
-    // Only what starts before this frame ends: the conversion may stop at any frame (--frames, a
-    // damaged input), and audio already written past that point could not be taken back.
-    carry_until(last_end_s_ - 1e-6, end_s_);
-    if (audio_) encode_audio_until(std::llround(last_end_s_ * audio_->sample_rate()));
-  }
-  void finish() override {
-    // Audio ends with the video (what was converted), not with the source.
-    carry_until(last_end_s_, last_end_s_);
-    encoder_->finish();
-  }
-  std::string description() const override { return output_; }
-
- private:
-  // The carried packets up to output time `until_s`, before `end_s`.
-  void carry_until(std::optional<double> until_s, std::optional<double> end_s) {
-    if (!carried_) return;
-    while (auto packet = carried_->next_packet(carried_indices_, until_s, end_s))
-      encoder_->write_source_packet(packet.get(), packet->stream_index);
-  }
-  // The decoded sound up to its first `until` sample frames in all (a stream that ends early ends
-  // the track there). It follows on from 0 as the chunks come; their own times are not read.
-  void encode_audio_until(std::int64_t until) {
-    while (audio_written_ < until) {
-      if (pending_offset_ >= pending_.frames()) {
-        std::optional<AudioChunk> chunk;
-        try {
-          chunk = audio_->next();
-        } catch (const AudioError& e) {
-          throw UserError(e.what(), 1);
-        }
-        if (!chunk) return;
-        pending_ = std::move(*chunk);
-        pending_offset_ = 0;
-        continue;
-      }
-      const std::int64_t count = std::min(until - audio_written_, pending_.frames() - pending_offset_);
-      encoder_->write_audio(pending_.samples.data() + pending_offset_ * pending_.channels, static_cast<int>(count));
-      pending_offset_ += count;
-      audio_written_ += count;
-    }
-  }
-
-  std::string output_;
-  double frame_rate_;
-  std::unique_ptr<CarriedStreams> carried_;
-  std::vector<int> carried_indices_;  // what the encoder carries of carried_
-  std::unique_ptr<AudioStream> audio_;
-  AudioChunk pending_;  // decoded and not all encoded yet, from pending_offset_ on
-  std::int64_t pending_offset_ = 0;
-  std::optional<VideoEncoder> encoder_;
-  std::optional<double> end_s_;
-  double last_end_s_ = 0.0;
-  std::int64_t audio_written_ = 0;  // sample frames
-};
-
-// frames_%05d.png: one image per frame. Written files are removed again unless finish() is reached.
-// A plain image name (x.png) holds the one frame converted, written only by finish(): the file
-// appears when the conversion succeeded, or not at all.
-class ImageSequenceSink final : public FrameSink {
- public:
-  ImageSequenceSink(const VideoConvertRequest& r)
-      : pattern_(r.output),
-        inputs_(r.inputs),
-        single_(!is_image_sequence_pattern(r.output)),
-        options_{r.encoder.overwrite, 8} {}
-  ~ImageSequenceSink() override {
-    if (finished_) return;
-    std::error_code ec;
-    for (const auto& f : written_) std::filesystem::remove(f, ec);
-  }
-  void write(const PackedFrame& frame) override {
-    if (single_) {
-      if (single_frame_) throw std::logic_error("a single image output was given a second frame");
-      single_frame_.emplace(frame);
-      return;
-    }
-    write_frame(frame, fmt::sprintf(pattern_, static_cast<int>(written_.size()) + 1));
-  }
-  void finish() override {
-    if (single_ && single_frame_) write_frame(*single_frame_, pattern_);
-    finished_ = true;
-  }
-  std::string description() const override { return pattern_; }
-
- private:
-  void write_frame(const PackedFrame& frame, const std::string& name) {
-    // Any frame's name may be an input (out_%05d.png expanding to an input's name, or a link to it).
-    inputs_.refuse_as_output(name);
-    Image image(frame.width, frame.height);
-    const std::size_t bpp = bytes_per_pixel(frame.bits);
-    float* out = image.data();
-    for (std::size_t i = 0; i < static_cast<std::size_t>(frame.width) * frame.height * 4; ++i) {
-      if (bpp == 8) {
-        std::uint16_t v;
-        std::memcpy(&v, &frame.rgba[i * 2], 2);
-        out[i] = v / 65535.f;
-      } else {
-        out[i] = frame.rgba[i] / 255.f;
-      }
-    }
-    options_.bits = frame.bits > 8 ? 16 : 8;
-    try {
-      write_image_file(image, name, options_);
-    } catch (const std::exception& e) {
-      throw UserError(e.what(), 1);
-    }
-    written_.push_back(name);
-  }
-
-  std::string pattern_;
-  const InputFiles& inputs_;
-  bool single_;
-  std::optional<PackedFrame> single_frame_;
-  ImageWriteOptions options_;
-  std::vector<std::filesystem::path> written_;
-  bool finished_ = false;
-};
 
 // Packed-frame buffers go back to the GL stage once encoded. A fresh 7.5 MB vector per frame,
 // allocated on one thread and freed on another, came back from the kernel every time: zero-filled
@@ -228,57 +82,29 @@ class FirstError {
   std::atomic<bool> failed_{false};
 };
 
-// What a sink is opened with, once the packed frame's size is known.
-struct FrameSinkContext {
-  const VideoConvertRequest& request;
-  Source& source;
-  int width, height, bits;
-};
-
-// The outputs of `nelf convert` for video, chosen by the output name: the first row whose test
-// accepts it. A new kind of output is its sink plus one row.
-struct FrameSinkDriver {
-  std::string_view name;
-  bool (*accepts)(const std::string& output);
-  std::unique_ptr<FrameSink> (*open)(const FrameSinkContext& context);
-};
-
-constexpr FrameSinkDriver kFrameSinks[] = {
-    {"raw", is_raw_output,
-     [](const FrameSinkContext& c) {
-       return open_raw_frame_sink(STDOUT_FILENO, c.width, c.height, c.source.info().frame_rate);
-     }},
-    {"image", [](const std::string& o) { return is_image_sequence_pattern(o) || is_image_file_name(o); },
-     [](const FrameSinkContext& c) -> std::unique_ptr<FrameSink> {
-       return std::make_unique<ImageSequenceSink>(c.request);
-     }},
-    {"encoded", [](const std::string&) { return true; },
-     [](const FrameSinkContext& c) -> std::unique_ptr<FrameSink> {
-       std::unique_ptr<CarriedStreams> carried;
-       std::unique_ptr<AudioStream> audio;
-       if (c.request.encoder.audio) {
-         carried = c.source.open_carried_streams();
-         if (!carried) audio = c.source.open_audio({}).stream;
-       }
-       return std::make_unique<EncodedFileSink>(c.request, std::move(carried), std::move(audio), c.width, c.height,
-                                                c.bits, c.source.info().frame_rate);
-     }},
-};
-
-std::unique_ptr<FrameSink> open_frame_sink(const FrameSinkContext& context) {
-  for (const FrameSinkDriver& driver : kFrameSinks)
-    if (driver.accepts(context.request.output)) return driver.open(context);
-  throw std::logic_error("no frame sink accepts " + context.request.output);
+// The file sink the output name chooses, opened once the packed frame's size is known; the
+// source's streams are opened only for a row that writes them.
+std::unique_ptr<FrameSink> open_frame_sink(const VideoConvertRequest& r, Source& source, int width, int height,
+                                           int bits) {
+  const FileSinkDriver& driver = file_sink_driver_for(r.output);
+  FrameSinkRequest request;
+  request.output = r.output;
+  request.width = width;
+  request.height = height;
+  request.bits = bits;
+  request.frame_rate = source.info().frame_rate;
+  request.encoder = r.encoder;
+  request.duration_s = r.duration_s;
+  if (driver.carries_streams && r.encoder.audio) {
+    request.carried = source.open_carried_streams();
+    if (!request.carried) request.audio = source.open_audio({}).stream;
+  }
+  request.refuse_as_output = [&inputs = r.inputs](const std::string& name) { inputs.refuse_as_output(name); };
+  request.raw_fd = STDOUT_FILENO;
+  return driver.open_file(std::move(request));
 }
 
 }  // namespace
-
-bool is_raw_output(const std::string& output) { return output == "-"; }
-
-bool is_image_sequence_pattern(const std::string& output) {
-  static const std::regex pattern("%0?[0-9]*d");
-  return std::regex_search(std::filesystem::path(output).filename().string(), pattern);
-}
 
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
@@ -365,7 +191,7 @@ void convert_video(const VideoConvertRequest& r) {
   std::unique_ptr<FrameSink> sink;
   try {
     const auto [width, height] = size_future.get();
-    sink = open_frame_sink({r, *source, width, height, bits});
+    sink = open_frame_sink(r, *source, width, height, bits);
     ProgressReporter progress(total, ProgressReporter::style_for(r.quiet));
     std::jthread watchdog([&](std::stop_token stop) {
       while (!stop.stop_requested()) {

@@ -34,12 +34,6 @@ struct VideoConvertRequest {
   std::int64_t max_pixels = kDefaultMaxPixels;
 };
 
-// True for `-`: raw packed frames on stdout (hmz_output/frame_sink.hpp).
-bool is_raw_output(const std::string& output);
-
-// True when `output` names an image sequence (a printf pattern like %05d).
-bool is_image_sequence_pattern(const std::string& output);
-
 // Runs the conversion. Throws UserError (status 1 for failed jobs, 130 when interrupted); leaves no
 // output behind on any failure.
 void convert_video(const VideoConvertRequest& request);

@@ -24,7 +24,7 @@ std::unique_ptr<Display> open_live_display(const LiveDisplayRequest& request, co
     throw UserError(e.what(), 2);
   }
   try {
-    return driver->open(options);
+    return driver->open_display(options);
   } catch (const std::exception& e) {
     throw UserError(e.what(), 1);
   }

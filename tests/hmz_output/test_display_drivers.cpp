@@ -16,7 +16,7 @@ TEST(DisplayDrivers, EveryRowHasAUniqueNameHelpAndOpener) {
   for (const DisplayDriver& driver : display_drivers()) {
     EXPECT_FALSE(driver.name.empty());
     EXPECT_FALSE(driver.help.empty()) << driver.name;
-    EXPECT_NE(driver.open, nullptr) << driver.name;
+    EXPECT_NE(driver.open_display, nullptr) << driver.name;
     EXPECT_TRUE(names.insert(driver.name).second) << driver.name << " twice";
     EXPECT_EQ(find_display_driver(driver.name), &driver);
   }

@@ -16,7 +16,7 @@ TEST(DisplayDrivers, OffscreenOpensWithoutADisplayServer) {
   DisplayOptions options;
   options.signal = *find_signal("hdmi-fp-720p60");
   options.packed = {options.signal.packed_width(1280), options.signal.packed_height(720)};
-  const auto display = display_driver("offscreen").open(options);
+  const auto display = display_driver("offscreen").open_display(options);
   EXPECT_EQ(display->packed_size(), (std::array<int, 2>{1280, 1470}));
   EXPECT_NE(display->packed_framebuffer(), 0u);
   EXPECT_NE(display->packed_texture(), 0u);
@@ -27,7 +27,7 @@ TEST(DisplayDrivers, OffscreenOpensWithoutADisplayServer) {
   EXPECT_NO_THROW(display->present());
   EXPECT_EQ(display->description().rfind("offscreen 1280x1470 (", 0), 0u) << display->description();
   options.packed = {0, 0};
-  EXPECT_THROW(display_driver("offscreen").open(options), std::invalid_argument);
+  EXPECT_THROW(display_driver("offscreen").open_display(options), std::invalid_argument);
 }
 
 }  // namespace

@@ -60,7 +60,7 @@ TEST_P(DisplayConformance, OpensAndKeepsTheContractOrRefusesInOneLine) {
   std::unique_ptr<Display> display;
   std::string refusal;
   try {
-    display = driver.open(options);
+    display = driver.open_display(options);
   } catch (const std::exception& e) {
     refusal = e.what();
   }

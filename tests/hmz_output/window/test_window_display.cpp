@@ -185,7 +185,7 @@ TEST_F(WindowDisplayTest, TwoDisplaysInTurnEachGetAWorkingContext) {
 
 TEST_F(WindowDisplayTest, QuadBufferOnMesaSaysThereAreNoStereoVisuals) {
   try {
-    display_driver("quad-buffer").open(frame_packed_options());
+    display_driver("quad-buffer").open_display(frame_packed_options());
     FAIL() << "Mesa offered a stereo visual";
   } catch (const std::runtime_error& e) {
     const std::string message = e.what();
@@ -437,7 +437,7 @@ TEST(WindowDisplayErrors, QuadBufferNeedsBothEyes) {
   DisplayOptions options = frame_packed_options();
   options.signal = *find_signal("left");
   options.packed = {1280, 720};
-  EXPECT_THROW(display_driver("quad-buffer").open(options), std::invalid_argument);
+  EXPECT_THROW(display_driver("quad-buffer").open_display(options), std::invalid_argument);
 }
 
 }  // namespace
