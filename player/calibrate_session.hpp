@@ -13,7 +13,7 @@
 namespace nelf {
 
 struct CalibrateSession {
-  std::string output = "window";  // a row of hmz_output/display_drivers.cpp
+  std::string output = "window";  // a live row of hmz_output/output_drivers.cpp
   Profile profile;
   Signal signal;
   TestPattern pattern = TestPattern::stripes;

@@ -13,7 +13,7 @@
 namespace nelf {
 
 struct LiveDisplayRequest {
-  std::string output = "window";  // a row of hmz_output/display_drivers.cpp
+  std::string output = "window";  // a live row of hmz_output/output_drivers.cpp
   std::string monitor;            // fullscreen: a name to match ("" = the one containing "HMZ")
   std::string connector;          // kms: connector name ("" = the first with a 3D frame-packing mode)
   std::string title = "nelf";

@@ -1,5 +1,5 @@
 // The live-output contract (hmz_output/display.hpp), run against every row of the output table
-// (hmz_output/display_drivers.cpp) on a private Xvfb server: an output either opens and behaves as
+// (the live rows of hmz_output/output_drivers.cpp) on a private Xvfb server: an output either opens and behaves as
 // the player needs — the packed framebuffer of the size asked for, its texture behind it, a
 // context that can be made current, present() and poll_events() that work, a description, a
 // refresh rate — or refuses with one line naming what to do. A new row is covered without a line

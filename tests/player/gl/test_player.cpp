@@ -46,7 +46,7 @@ class PlayerTest : public ::testing::Test {
   PlayerOptions silent_options() const { return test::silent_options(dir_); }
   // The offscreen output showing the packed frame of `options`' 160x90 panel.
   static std::unique_ptr<Display> open_display(const PlayerOptions& options) {
-    return display_driver("offscreen").open(test::small_panel_display_options(options));
+    return display_driver("offscreen").open_display(test::small_panel_display_options(options));
   }
 };
 
