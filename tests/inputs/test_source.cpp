@@ -19,7 +19,7 @@ namespace {
 using test::make_media;
 using test::TempDir;
 
-class StereoFrameSourceTest : public ::testing::Test {
+class SourceTest : public ::testing::Test {
  protected:
   void SetUp() override { quiet_ffmpeg_logs(true); }
   TempDir dir;
@@ -55,7 +55,7 @@ void expect_views(const StereoVideoFrame& f, std::array<int, 2> block) {
   EXPECT_LT(channel_mean(f.right, 0), 0.1);
 }
 
-TEST_F(StereoFrameSourceTest, DeliversTheNegotiatedBlockMeansFromTheFirstFrameOn) {
+TEST_F(SourceTest, DeliversTheNegotiatedBlockMeansFromTheFirstFrameOn) {
   auto source = open_source(request_for(make_sbs_clip(dir)));
   const ViewGeometry view = source->info().view;
   EXPECT_EQ(view.width, 64);  // the view, not the frame
@@ -67,7 +67,7 @@ TEST_F(StereoFrameSourceTest, DeliversTheNegotiatedBlockMeansFromTheFirstFrameOn
   EXPECT_NEAR(first->pts_s, 0.0, 1e-6);
 }
 
-TEST_F(StereoFrameSourceTest, ASeekKeepsTheViewsReduced) {
+TEST_F(SourceTest, ASeekKeepsTheViewsReduced) {
   auto source = open_source(request_for(make_sbs_clip(dir)));
   source->negotiate({{2, 3}});
   ASSERT_TRUE(source->next());
@@ -84,7 +84,7 @@ TEST_F(StereoFrameSourceTest, ASeekKeepsTheViewsReduced) {
   expect_views(*again, {2, 3});
 }
 
-TEST_F(StereoFrameSourceTest, TheBlockCanChangeMidStreamAndBackToWholeViews) {
+TEST_F(SourceTest, TheBlockCanChangeMidStreamAndBackToWholeViews) {
   auto source = open_source(request_for(make_sbs_clip(dir)));
   const auto whole = source->next();
   ASSERT_TRUE(whole);
@@ -101,7 +101,7 @@ TEST_F(StereoFrameSourceTest, TheBlockCanChangeMidStreamAndBackToWholeViews) {
   expect_views(*back, {1, 1});
 }
 
-TEST_F(StereoFrameSourceTest, ABlockThatDoesNotDivideTheViewGivesWholeViews) {
+TEST_F(SourceTest, ABlockThatDoesNotDivideTheViewGivesWholeViews) {
   auto source = open_source(request_for(make_sbs_clip(dir)));
   EXPECT_EQ(source->negotiate({{5, 5}}), (ViewFormat{{1, 1}}));
   const auto f = source->next();
@@ -109,7 +109,7 @@ TEST_F(StereoFrameSourceTest, ABlockThatDoesNotDivideTheViewGivesWholeViews) {
   expect_views(*f, {1, 1});
 }
 
-TEST_F(StereoFrameSourceTest, ChangingTheBlockBeforeTheFirstFrameReconvertsIt) {
+TEST_F(SourceTest, ChangingTheBlockBeforeTheFirstFrameReconvertsIt) {
   // The first frame is decoded while opening (layout detection); asking afterwards must not hand
   // it out at the old size.
   auto source = open_source(request_for(make_sbs_clip(dir)));
@@ -120,7 +120,7 @@ TEST_F(StereoFrameSourceTest, ChangingTheBlockBeforeTheFirstFrameReconvertsIt) {
   expect_views(*first, {2, 2});
 }
 
-TEST_F(StereoFrameSourceTest, SyntheticSourceAlwaysDeliversWholeViews) {
+TEST_F(SourceTest, SyntheticSourceAlwaysDeliversWholeViews) {
   auto source = open_source(request_for("synthetic:duration=1"));
   EXPECT_EQ(source->negotiate({{2, 2}}), (ViewFormat{{1, 1}}));
   const auto f = source->next();
@@ -170,7 +170,7 @@ TEST(SourceDefaults, ASourceThatCannotSeekRefusesInOneLine) {
   }
 }
 
-TEST_F(StereoFrameSourceTest, AFileSaysItsRateFramesDurationAndThatItCanSeek) {
+TEST_F(SourceTest, AFileSaysItsRateFramesDurationAndThatItCanSeek) {
   auto source = open_source(request_for(make_sbs_clip(dir)));
   const SourceInfo info = source->info();
   EXPECT_DOUBLE_EQ(info.frame_rate, 10.0);
