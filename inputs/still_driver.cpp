@@ -5,13 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <memory>
 
 #include "core/printable.hpp"
 #include "core/user_error.hpp"
 #include "inputs/source.hpp"
 #include "inputs/still_source.hpp"
+#include "inputs/view_bytes.hpp"
 
 namespace nelf::drivers {
 namespace {
@@ -31,23 +31,6 @@ int bits_for(const Image& left, const Image& right) {
     }
   }
   return 8;
-}
-
-// Tightly packed RGBA of `bits` per channel (16: native-endian uint16), as StereoVideoFrame holds it.
-std::vector<std::uint8_t> to_bytes(const Image& image, int bits) {
-  const std::size_t n = static_cast<std::size_t>(image.width()) * image.height() * 4;
-  const float* p = image.data();
-  std::vector<std::uint8_t> out(n * (bits > 8 ? 2 : 1));
-  for (std::size_t i = 0; i < n; ++i) {
-    const float v = std::clamp(p[i], 0.f, 1.f);
-    if (bits > 8) {
-      const auto value = static_cast<std::uint16_t>(std::lround(v * 65535.f));
-      std::memcpy(&out[2 * i], &value, 2);
-    } else {
-      out[i] = static_cast<std::uint8_t>(std::lround(v * 255.f));
-    }
-  }
-  return out;
 }
 
 class StillFrameSource final : public Source {
@@ -94,8 +77,8 @@ class StillFrameSource final : public Source {
     frame.width = views_->left.image.width();
     frame.height = views_->left.image.height();
     frame.bits = bits_for(views_->left.image, views_->right.image);
-    frame.left = to_bytes(views_->left.image, frame.bits);
-    frame.right = to_bytes(views_->right.image, frame.bits);
+    frame.left = view_bytes(views_->left.image, frame.bits);
+    frame.right = view_bytes(views_->right.image, frame.bits);
     frame.aspect = views_->left.aspect();
     frame.exact_views = views_;
     return frame;

@@ -10,17 +10,10 @@
 #include "inputs/source.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/synthetic_tone.hpp"
+#include "inputs/view_bytes.hpp"
 
 namespace nelf::drivers {
 namespace {
-
-std::vector<std::uint8_t> to_rgba8(const Image& image) {
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(image.width()) * image.height() * 4);
-  const float* p = image.data();
-  for (std::size_t i = 0; i < out.size(); ++i)
-    out[i] = static_cast<std::uint8_t>(std::lround(std::clamp(p[i], 0.f, 1.f) * 255.f));
-  return out;
-}
 
 class SyntheticFrameSource final : public Source {
  public:
@@ -32,8 +25,8 @@ class SyntheticFrameSource final : public Source {
     StereoVideoFrame f{pair.left.image.width(),
                        pair.left.image.height(),
                        8,
-                       to_rgba8(pair.left.image),
-                       to_rgba8(pair.right.image),
+                       view_bytes(pair.left.image, 8),
+                       view_bytes(pair.right.image, 8),
                        pair.left.aspect(),
                        static_cast<double>(next_ - first_) / clip_.settings().fps,
                        {1, 1},
