@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/image.hpp"
+#include "core/view_disparity.hpp"
 
 namespace nelf {
 
@@ -42,6 +43,7 @@ struct StereoVideoFrame {
   // The same two views at the source's own precision, when it has them as float (a still): what
   // `nelf convert` composes a still from, so that its output never goes through `bits`.
   std::shared_ptr<const StereoPair> exact_views;
+  std::shared_ptr<const StereoDisparity> disparity;  // the content's depth, when known or estimated
 };
 
 inline std::size_t bytes_per_pixel(int bits) { return bits > 8 ? 8 : 4; }

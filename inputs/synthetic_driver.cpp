@@ -30,6 +30,7 @@ class SyntheticFrameSource final : public Source {
                        pair.left.aspect(),
                        static_cast<double>(next_ - first_) / clip_.settings().fps,
                        {1, 1},
+                       nullptr,
                        nullptr};
     ++next_;
     return f;
