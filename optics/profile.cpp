@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/embedded.hpp"
+#include "optics/defect_map.hpp"
 #include "optics/optics.hpp"
 
 namespace nelf {
@@ -287,6 +288,22 @@ void check_derived_figures(const Reader& r, const Profile& p) {
     r.fail(r.find("magnifier_comparison"), "[magnifier_comparison]", "gives a magnifier bound that is not finite");
 }
 
+// correction.defect_map, found beside the profile file (origin), read and validated against the
+// panel. A missing file is the profile's error (its file, line and key); a bad line is the map's.
+void read_profile_defect_map(const Reader& r, Profile& p, const std::string& origin) {
+  const std::filesystem::path given(p.correction.defect_map);
+  std::filesystem::path base;
+  if (origin.rfind("built-in ", 0) != 0) base = std::filesystem::path(origin).parent_path();
+  const std::filesystem::path path = given.is_absolute() || base.empty() ? given : base / given;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    r.fail(r.find("correction.defect_map"), "correction.defect_map",
+           fmt::format("names \"{}\" ({}), which {}", p.correction.defect_map, path.string(),
+                       std::filesystem::exists(path, ec) ? "is not a regular file" : "does not exist"));
+  p.correction.defect_map_path = path;
+  p.correction.defects = std::make_shared<const DefectMap>(read_defect_map(path, p.display.resolution));
+}
+
 Profile read_profile(const toml::table& root, const std::string& origin) {
   Reader r(root, origin);
   r.reject_unknown_keys(root, "");
@@ -476,6 +493,7 @@ Profile read_profile(const toml::table& root, const std::string& origin) {
             fmt::format("at most {}", kMaxFNumber), p.magnifier_comparison.f_number);
 
   check_derived_figures(r, p);
+  if (!p.correction.defect_map.empty()) read_profile_defect_map(r, p, origin);
   return p;
 }
 

@@ -3,6 +3,7 @@
 // Profiles are TOML files; the built-ins (`hmz-t1`, `hmz-t1-stock`) are embedded in the binary.
 #include <array>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -64,9 +65,15 @@ struct EyeCalibration {
   double pitch_scale = 1.0;   // k
 };
 
+struct DefectMap;  // optics/defect_map.hpp
+
 struct CorrectionSpec {
   double prescription_diopters = 0.0;
-  std::string defect_map;
+  std::string defect_map;                 // as the profile gives it: relative to the profile file's directory
+  std::filesystem::path defect_map_path;  // where it was read from ("" without a map)
+  // The map read when the profile was loaded (null without one): validated against the panel, so
+  // every command that takes a profile refuses a bad map.
+  std::shared_ptr<const DefectMap> defects;
 };
 
 struct MagnifierComparison {
@@ -93,7 +100,9 @@ struct Profile {
   const EyeCalibration& eye_calibration(Eye eye) const { return calibration[static_cast<int>(eye)]; }
 };
 
-// Parses and validates a profile from TOML text. `origin` names it in error messages.
+// Parses and validates a profile from TOML text. `origin` names it in error messages, and is the
+// file a relative correction.defect_map is found beside (the working directory for a built-in);
+// the map is read and validated against the panel here.
 Profile parse_profile(std::string_view toml_text, const std::string& origin);
 
 // A built-in name (see builtin_profile_names()) or a path to a TOML file.

@@ -215,6 +215,14 @@ void save_calibrated_profile(const Profile& profile, const std::string& path) {
   // The saved file is a profile of its own, not the one it started from.
   Profile saved = profile;
   saved.name = calibrated_profile_name(path);
+  // A defect map named relative to the profile stays found from the saved file's directory.
+  if (!saved.correction.defect_map_path.empty()) {
+    std::error_code ec;
+    const auto directory = std::filesystem::absolute(std::filesystem::path(path), ec).parent_path();
+    const auto relative =
+        std::filesystem::relative(std::filesystem::absolute(saved.correction.defect_map_path, ec), directory, ec);
+    if (!ec && !relative.empty()) saved.correction.defect_map = relative.string();
+  }
   try {
     write_file_atomically(path, true, [&](const std::filesystem::path& temporary) {
       std::ofstream out(temporary, std::ios::binary);
