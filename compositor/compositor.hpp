@@ -3,11 +3,23 @@
 // (DESIGN.md §3–4). Implementations: the OpenGL path (gl_compositor) and the CPU reference.
 #include <array>
 #include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "core/image.hpp"
 #include "optics/profile.hpp"
 
 namespace nelf {
+
+// Where the content's depth comes from (`--depth`): off, the flat emulated screen for everything;
+// auto, the depth a frame carries (StereoVideoFrame::disparity: a synthetic scene's exact depth),
+// the flat screen for frames without it.
+enum class DepthMode { off, automatic };
+// The names `--depth` takes, in order, and the mode of one (nothing for an unknown name).
+const std::vector<std::string>& depth_mode_names();
+std::optional<DepthMode> parse_depth_mode(std::string_view name);
+std::string_view depth_mode_name(DepthMode mode);
 
 struct CompositorOptions {
   // 0: one bilinear tap (comparison only); 1: footprint prefilter (default);
@@ -16,6 +28,7 @@ struct CompositorOptions {
   // EGL device index for the GL compositor (`--gpu N`); unset: NELF_GPU, else the first hardware
   // device, else Mesa's software renderer.
   std::optional<int> gpu;
+  DepthMode depth = DepthMode::off;
 };
 
 // Throws std::invalid_argument naming the allowed values when `fsaa` is not 0, 1, 4 or 16.

@@ -131,6 +131,7 @@ void FrameCompositor::prepare(const Frame& frame, const FrameOverlays& overlays)
   frame_ = frame;
   calibration_ = overlays.calibration_grid;
   textures_current_ = false;
+  update_depth(*frame);
   // The GL path's uploads now (the player times them apart from the render); the CPU path's frames
   // need none, and a key that hands a frame to GL uploads it then.
   if (!use_tables() && compositor_) upload_views();
@@ -141,6 +142,8 @@ void FrameCompositor::prepare(const Frame& frame, const FrameOverlays& overlays)
 // it pays (software GL, or NELF_COMPOSITE). Not with block means made for optics a key has changed
 // since (the GL path's smaller view covers the frames until the new block arrives).
 bool FrameCompositor::table_path_open() const {
+  // The tables replay the flat screen's taps; a frame with depth needs its own per pixel.
+  if (depth_frame_) return false;
   if (views_.width == 0 || views_.bits != 8 || (table_use_ == TableUse::block_means && !reduced())) return false;
   for (Eye eye : {Eye::left, Eye::right})
     if (layout_.origins[static_cast<int>(eye)] && views_.block != current_wanted_block(eye)) return false;
@@ -372,12 +375,52 @@ void FrameCompositor::render_gl(const FrameOverlays& overlays, unsigned int fram
                                 views_.aspect > 0.0 ? views_.aspect : double(views_.width) / views_.height};
     const GlTextureView shown = message ? overlay_->apply(eye, texture) : texture;
     const GlTarget target{framebuffer, origin->first, origin->second};
+    compositor_->set_depth(eye, depth_frame_ ? surfaces_[view] : nullptr);
     if (reduced() && views_.block == current_wanted_block(eye))
       compositor_->render_eye_reduced(
           eye, GlReducedView{{shown.texture, views_.width, views_.height, views_.aspect}, views_.block}, target);
     else  // whole views, or block means made for optics changed since (a key): a smaller view
       compositor_->render_eye(eye, shown, target);
   }
+}
+
+// Whether `frame` is composited with its depth, and its surfaces when it is. A depth that cannot
+// be used gives the flat screen, said once.
+void FrameCompositor::update_depth(const StereoVideoFrame& frame) {
+  depth_frame_ = false;
+  if (options_.depth == DepthMode::off) return;
+  if (!profile_.lens_array) {
+    depth_notice(
+        fmt::format("profile {} has no lens array: its picture cannot follow the content's depth; showing "
+                    "the flat view",
+                    profile_.name));
+    return;
+  }
+  if (!frame.disparity) {
+    depth_notice(
+        "this source carries no depth (synthetic: scenes know theirs; estimating it from the two views is not "
+        "built in); showing the flat screen");
+    return;
+  }
+  if (frame.disparity != surfaces_from_) {
+    try {
+      surfaces_ = {std::make_shared<const DisparitySurface>(frame.disparity->left),
+                   std::make_shared<const DisparitySurface>(frame.disparity->right)};
+      surfaces_from_ = frame.disparity;
+    } catch (const std::invalid_argument& e) {
+      surfaces_ = {};
+      surfaces_from_.reset();
+      depth_notice(fmt::format("the frame's depth is unusable ({}); showing the flat screen", e.what()));
+      return;
+    }
+  }
+  depth_frame_ = true;
+}
+
+void FrameCompositor::depth_notice(const std::string& why) {
+  if (depth_notice_given_) return;
+  depth_notice_given_ = true;
+  fmt::print(stderr, "nelf: --depth {}: {}\n", depth_mode_name(options_.depth), why);
 }
 
 // A BGRA packed frame into the target's (BGRA) texture: a copy.
@@ -393,6 +436,9 @@ void FrameCompositor::composite_ahead(std::span<const Frame> frames, const Frame
 }
 
 Image FrameCompositor::render_still(const StereoPair& views) {
+  if (options_.depth != DepthMode::off)
+    depth_notice(
+        "a still carries no depth (estimating it from the two views is not built in); showing the flat screen");
   start_gl();
   return place_eyes(layout_, compositor_->compose(views));
 }

@@ -24,6 +24,7 @@
 #include "core/image.hpp"
 #include "core/packed_layout.hpp"
 #include "core/packed_target.hpp"
+#include "optics/depth.hpp"
 #include "optics/profile.hpp"
 
 namespace nelf {
@@ -122,6 +123,11 @@ class FrameCompositor {
   // Waits (up to `timeout`) until the worker has made what it was asked for.
   void wait_for_ahead(std::chrono::milliseconds timeout) { ahead_.wait_until_idle(timeout); }
 
+  // Whether the frame last prepared is composited with its depth (options().depth, the frame's
+  // disparity, a lens-array profile): such frames go the GL path, each pixel showing the view where
+  // its ray meets the content's surface.
+  bool depth_aware() const { return depth_frame_; }
+
   // A still: float views composited by GL (no composite tables: they replay 8-bit block means,
   // and stills keep 16-bit and float precision) and placed by the layout, cropped to the eye areas
   // as pack_eyes does. The views' own size and aspect; frames are not involved.
@@ -150,6 +156,8 @@ class FrameCompositor {
   void render_gl(const FrameOverlays& overlays, unsigned int framebuffer);
   void upload_views();
   void upload_packed(const GlPackedTarget& target, const std::uint8_t* bgra);
+  void update_depth(const StereoVideoFrame& frame);
+  void depth_notice(const std::string& why);
 
   Profile profile_;
   CompositorOptions options_;
@@ -192,6 +200,12 @@ class FrameCompositor {
   // tables and the setup last handed to it, and the worker (last: it stops first).
   Frame frame_;
   bool calibration_ = false;
+  // The depth of the frame last prepared: per view, its surface (made once per disparity), and
+  // whether it is used; the one line said when it cannot be.
+  std::shared_ptr<const StereoDisparity> surfaces_from_;
+  std::array<std::shared_ptr<const DisparitySurface>, 2> surfaces_;
+  bool depth_frame_ = false;
+  bool depth_notice_given_ = false;
   std::shared_ptr<std::array<std::optional<CompositeTable>, 2>> worker_tables_;
   std::shared_ptr<const CompositeSetup> setup_;
   CompositeAhead ahead_{ahead_depth};

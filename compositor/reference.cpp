@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -13,6 +15,19 @@ void validate_fsaa(int fsaa) {
   if (fsaa != 0 && fsaa != 1 && fsaa != 4 && fsaa != 16)
     throw std::invalid_argument(fmt::format("--fsaa must be 0, 1, 4 or 16, got {}", fsaa));
 }
+
+const std::vector<std::string>& depth_mode_names() {
+  static const std::vector<std::string> names{"off", "auto"};
+  return names;
+}
+
+std::optional<DepthMode> parse_depth_mode(std::string_view name) {
+  if (name == "off") return DepthMode::off;
+  if (name == "auto") return DepthMode::automatic;
+  return std::nullopt;
+}
+
+std::string_view depth_mode_name(DepthMode mode) { return mode == DepthMode::off ? "off" : "auto"; }
 
 Rgba sample_bilinear(const Image& image, double u, double t) {
   const double x = u * image.width() - 0.5, y = t * image.height() - 0.5;
@@ -30,7 +45,10 @@ Rgba sample_bilinear(const Image& image, double u, double t) {
           mix(p00.a, p10.a, p01.a, p11.a)};
 }
 
-Image reference_eye_image(const EyeMapping& mapping, const Image& view, int subsamples) {
+namespace {
+
+Image render_reference(const EyeMapping& mapping, const Image& view, int subsamples,
+                       const std::function<std::optional<Vec2>(Vec2)>& coordinate) {
   if (subsamples < 1) throw std::invalid_argument("reference_eye_image: subsamples must be >= 1");
   if (view.empty()) throw std::invalid_argument("reference_eye_image: empty view");
   Image out(mapping.panel[0], mapping.panel[1]);
@@ -42,7 +60,7 @@ Image reference_eye_image(const EyeMapping& mapping, const Image& view, int subs
         double r = 0, g = 0, b = 0;
         for (int sy = 0; sy < subsamples; ++sy) {
           for (int sx = 0; sx < subsamples; ++sx) {
-            const auto uv = view_coordinate_at_pixel(mapping, i + (sx + 0.5) * inv, j + (sy + 0.5) * inv);
+            const auto uv = coordinate(display_position_mm(mapping, i + (sx + 0.5) * inv, j + (sy + 0.5) * inv));
             if (!uv) continue;  // black there
             const Rgba c = sample_bilinear(view, uv->x, uv->y);
             r += c.r, g += c.g, b += c.b;
@@ -58,6 +76,25 @@ Image reference_eye_image(const EyeMapping& mapping, const Image& view, int subs
   for (int w = 1; w < workers; ++w) threads.emplace_back(render_rows, w, workers);
   render_rows(0, workers);
   return out;
+}
+
+}  // namespace
+
+Image reference_eye_image(const EyeMapping& mapping, const Image& view, int subsamples) {
+  return render_reference(mapping, view, subsamples, [&](Vec2 s) { return view_coordinate(mapping, s); });
+}
+
+Image reference_eye_image(const EyeMapping& mapping, const Image& view, const DisparitySurface& surface,
+                          const DepthGeometry& geometry, int subsamples) {
+  if (!mapping.has_lens_array) return reference_eye_image(mapping, view, subsamples);
+  return render_reference(mapping, view, subsamples, [&](Vec2 s) -> std::optional<Vec2> {
+    const auto flat = view_coordinate(mapping, s);
+    if (!flat) return std::nullopt;
+    const Vec2 c = *owner_lens_centre(mapping, s);
+    const Vec2 uv = surface.hit(*flat, pupil_gain(geometry, chief_ray_pupil_crossing(mapping, s, c)));
+    if (uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0) return std::nullopt;
+    return uv;
+  });
 }
 
 EyeImages ReferenceCompositor::compose(const StereoPair& views) {

@@ -4,6 +4,7 @@
 // owns its position), each a bilinear tap on the full-resolution view. Slow by design; it is the
 // oracle the GL path is tested against.
 #include "compositor/compositor.hpp"
+#include "optics/depth.hpp"
 #include "optics/mapping.hpp"
 
 namespace nelf {
@@ -14,6 +15,11 @@ Rgba sample_bilinear(const Image& image, double u, double t);
 
 // One eye's image: `subsamples` per axis (16 for the reference; fewer for quick checks).
 Image reference_eye_image(const EyeMapping& mapping, const Image& view, int subsamples = 16);
+
+// The depth-aware reference: each sub-sample shows the view where its chief ray meets `surface`
+// (optics/depth.hpp) under `geometry`, black off the screen. A flat surface gives reference_eye_image.
+Image reference_eye_image(const EyeMapping& mapping, const Image& view, const DisparitySurface& surface,
+                          const DepthGeometry& geometry, int subsamples = 16);
 
 class ReferenceCompositor final : public Compositor {
  public:

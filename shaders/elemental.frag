@@ -3,10 +3,11 @@
 // optics/mapping.cpp (view_coordinate) in float. Pixel positions are taken relative to the
 // panel's pixel grid, so float keeps sub-micrometre precision.
 //
-// Compiled in four variants (compositor/gl/shader_programs.cpp lists them, and the build validates
+// Compiled in six variants (compositor/gl/shader_programs.cpp lists them, and the build validates
 // each): as is for pass 1 (point samples over the whole region), with NELF_AREA_SAMPLE for the
-// border strips, NELF_COORDINATE_MAP for pass 1's coordinate map, and NELF_AREA_SAMPLE +
-// NELF_RECORD_TAPS for the CPU composite table. Compile-time switches: llvmpipe would otherwise
+// border strips, NELF_COORDINATE_MAP for pass 1's coordinate map, NELF_AREA_SAMPLE +
+// NELF_RECORD_TAPS for the CPU composite table, and NELF_DEPTH (with or without NELF_AREA_SAMPLE)
+// for pass 1 and the strips of the depth-aware composite. Compile-time switches: llvmpipe would otherwise
 // evaluate both sides of a run-time choice for every pixel.
 //
 // Memory layout: row 0 of the target region is the top row of the eye image (as in nelf::Image);
@@ -23,6 +24,46 @@ layout(binding = 0) uniform sampler2D u_view;  // the view, or its footprint-pre
 const int u_subsamples = NELF_SUBSAMPLES;
 
 out vec4 colour;
+
+#ifdef NELF_DEPTH
+// The depth-aware composite (optics/depth.hpp, DisparitySurface::hit, the same search in float):
+// each ray shows the view where it meets the content's surface rather than the flat screen.
+layout(binding = 2) uniform sampler2D u_disparity;  // R32F: δ / W per map texel, unknown ones filled
+layout(location = 1) uniform vec2 u_parallax_gain;  // uv shift per mm of pupil crossing per unit of δ / W
+layout(location = 2) uniform vec2 u_disparity_range;  // back (smallest), front (largest) δ / W
+layout(location = 3) uniform float u_pupil_per_lens;  // d_e / d_l: chief ray's pupil crossing = c − (s − c) · this
+const int depth_search_steps = 24;                   // optics/depth.hpp: depth_search_steps
+const int depth_search_bisections = 6;               // and depth_search_bisections
+
+float surface_disparity(vec2 uv) {
+  const ivec2 size = textureSize(u_disparity, 0);
+  return texelFetch(u_disparity, clamp(ivec2(floor(uv * vec2(size))), ivec2(0), size - 1), 0).r;
+}
+
+// The front-most crossing of the ray (meeting the flat screen at flat_uv, shifted by gain per unit
+// of δ / W) with the surface.
+vec2 surface_uv(vec2 flat_uv, vec2 gain) {
+  const float back = u_disparity_range.x, front = u_disparity_range.y;
+  if (!(front > back) || surface_disparity(flat_uv + gain * front) >= front) return flat_uv + gain * front;
+  float hit = back, before = front;
+  for (int i = 1; i <= depth_search_steps; ++i) {
+    const float d = front - (front - back) * float(i) / float(depth_search_steps);
+    if (surface_disparity(flat_uv + gain * d) >= d) {
+      hit = d;
+      break;
+    }
+    before = d;
+  }
+  for (int k = 0; k < depth_search_bisections; ++k) {
+    const float mid = 0.5 * (hit + before);
+    if (surface_disparity(flat_uv + gain * mid) >= mid)
+      hit = mid;
+    else
+      before = mid;
+  }
+  return flat_uv + gain * hit;
+}
+#endif
 
 bool inside(vec2 uv) { return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))); }
 
@@ -41,6 +82,9 @@ bool lens_coordinate(vec2 s, ivec2 lens, out vec2 uv) {
   const vec2 c = u_lattice_offset + rotate(vec2(lens) * u_lens_pitch, 1.0);
   const vec2 v = c + (s - c) * u_chief_ray_scale;  // chief ray back to the screen plane
   uv = vec2((v.x - u_screen_centre.x) / u_screen_size.x + 0.5, 0.5 - (v.y - u_screen_centre.y) / u_screen_size.y);
+#ifdef NELF_DEPTH
+  uv = surface_uv(uv, (c - (s - c) * u_pupil_per_lens) * u_parallax_gain);
+#endif
   return true;
 }
 

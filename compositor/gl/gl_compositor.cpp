@@ -257,7 +257,8 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
   // One tap per pixel from the prefiltered view (fsaa 1): the pixel's coordinate comes from a map
   // made once per eye and view geometry, so pass 1 only taps.
   const int e = static_cast<int>(eye);
-  const bool use_map = plan.enabled && subsamples == 1;
+  const bool depth = depth_[e].surface && m.has_lens_array;
+  const bool use_map = plan.enabled && subsamples == 1 && !depth;
   const bool new_map =
       use_map && (!coordinate_maps_[e].texture || coordinate_maps_[e].width != view.width ||
                   coordinate_maps_[e].height != view.height || coordinate_maps_[e].aspect != view.aspect());
@@ -271,6 +272,18 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
     map.aspect = view.aspect();
   }
   if (!use_map || border_strips) upload_mapping(m, texture, target.x, target.y);
+  if (depth) {
+    const DisparitySurface& surface = *depth_[e].surface;
+    const Vec2 gain = pupil_gain(depth_geometry(profile_, m), {1.0, 1.0});
+    for (shaders::ProgramKind kind : {shaders::ProgramKind::depth, shaders::ProgramKind::depth_border}) {
+      namespace at = shaders::location::depth;
+      glProgramUniform2f(program(kind), at::parallax_gain, f(gain.x), f(gain.y));
+      glProgramUniform2f(program(kind), at::disparity_range, surface.back(), surface.front());
+      glProgramUniform1f(program(kind), at::pupil_per_lens, f(m.eye_relief_mm / m.gap_mm));
+    }
+    glBindSampler(shaders::disparity_unit, 0);
+    glBindTextureUnit(shaders::disparity_unit, depth_[e].texture.id());
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   glViewport(target.x, target.y, m.panel[0], m.panel[1]);
   glBindSampler(shaders::view_unit, sampler_.id());
@@ -282,11 +295,11 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
                        f(target.y));
     glUseProgram(program(shaders::ProgramKind::lookup));
   } else {
-    glUseProgram(program(shaders::ProgramKind::elemental));
+    glUseProgram(program(depth ? shaders::ProgramKind::depth : shaders::ProgramKind::elemental));
   }
   glDrawArrays(GL_TRIANGLES, 0, 3);
   if (border_strips) {
-    glUseProgram(program(shaders::ProgramKind::border));
+    glUseProgram(program(depth ? shaders::ProgramKind::depth_border : shaders::ProgramKind::border));
     glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
   }
   gl::check_error("rendering an eye image");
@@ -357,6 +370,22 @@ std::optional<CompositeTable::Recording> GlCompositor::record_composite_table(Ey
   }
   gl::check_error("recording the composite table");
   return r;
+}
+
+void GlCompositor::set_depth(Eye eye, std::shared_ptr<const DisparitySurface> surface) {
+  DepthSurface& d = depth_[static_cast<int>(eye)];
+  if (surface == d.surface) return;
+  d.surface = std::move(surface);
+  if (!d.surface) return;
+  context_->make_current();
+  if (!d.texture || d.width != d.surface->width() || d.height != d.surface->height()) {
+    d.texture = gl::make_texture_2d(GL_R32F, d.surface->width(), d.surface->height());
+    d.width = d.surface->width();
+    d.height = d.surface->height();
+  }
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(d.texture.id(), 0, 0, 0, d.width, d.height, GL_RED, GL_FLOAT, d.surface->values().data());
+  gl::check_error("uploading the disparity");
 }
 
 CompositeChoice composite_choice() {

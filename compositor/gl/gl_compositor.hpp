@@ -26,6 +26,7 @@
 #include "core/gl/context.hpp"
 #include "core/gl/egl_context.hpp"
 #include "core/gl/objects.hpp"
+#include "optics/depth.hpp"
 #include "optics/mapping.hpp"
 
 namespace nelf {
@@ -97,6 +98,12 @@ class GlCompositor final : public Compositor {
   // Uploads both views, renders each eye and reads the images back.
   EyeImages compose(const StereoPair& views) override;
 
+  // The content's depth for `eye`'s next renders: each display pixel then shows the view where its
+  // chief ray (and, in the border strips, each part's ray) meets the content's surface rather than
+  // the flat screen (optics/depth.hpp). Null: the flat screen. A flat (all-zero) surface renders what
+  // no surface does. Stock profiles (no lenslets) keep the flat view.
+  void set_depth(Eye eye, std::shared_ptr<const DisparitySurface> surface);
+
   // Renders `eye` from `view` into `target` (panel-sized region). Prefilters the view first
   // (fsaa ≥ 1): call once per eye per frame. Leaves the target framebuffer bound.
   void render_eye(Eye eye, const GlTextureView& view, const GlTarget& target);
@@ -142,6 +149,11 @@ class GlCompositor final : public Compositor {
     gl::Texture texture;
     int width = 0, height = 0;
   };
+  struct DepthSurface {
+    std::shared_ptr<const DisparitySurface> surface;
+    gl::Texture texture;  // R32F, the surface's values
+    int width = 0, height = 0;
+  };
 
   struct TextureTransform {
     float scale[2] = {1.f, 1.f}, offset[2] = {0.f, 0.f};
@@ -170,6 +182,7 @@ class GlCompositor final : public Compositor {
   std::array<PrefilterTargets, 2> prefilter_targets_;  // per eye
   std::array<UploadedView, 2> uploads_;                // per eye, for compose()
   std::array<EyeTarget, 2> eye_targets_;               // per eye, for compose()
+  std::array<DepthSurface, 2> depth_;                  // per eye, set_depth
 };
 
 // Whether video paths should composite from a CompositeTable on the CPU rather than with GL: on a

@@ -12,13 +12,17 @@ namespace nelf::shaders {
 inline constexpr unsigned mapping_block_binding = 0;  // uniform block Mapping
 inline constexpr unsigned view_unit = 0;              // u_view (u_input in prefilter_box.frag)
 inline constexpr unsigned second_unit = 1;            // u_map (elemental_lookup.frag), u_label (text_overlay.frag)
+inline constexpr unsigned disparity_unit = 2;         // u_disparity (elemental.frag, NELF_DEPTH)
 
 // Uniform locations: `layout(location = N)`, per shader.
 namespace location {
 inline constexpr int record_part = 0;           // elemental.frag, NELF_RECORD_TAPS: u_part
 inline constexpr int lookup_region_origin = 0;  // elemental_lookup.frag: u_region_origin
 inline constexpr int reduce_block = 0;          // prefilter_reduce.frag: u_block
-namespace box {                                 // prefilter_box.frag
+namespace depth {                               // elemental.frag, NELF_DEPTH
+inline constexpr int parallax_gain = 1, disparity_range = 2, pupil_per_lens = 3;
+}
+namespace box {  // prefilter_box.frag
 inline constexpr int axis = 0, cell_size = 1, out_spacing = 2, box_width = 3, out_origin = 4, view_extent = 5;
 }
 inline constexpr int text_box_origin = 0, text_box_size = 1;  // text_overlay.frag

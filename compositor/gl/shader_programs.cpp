@@ -27,11 +27,18 @@ std::string_view kind_name(ProgramKind kind) {
       return "box";
     case ProgramKind::text_overlay:
       return "text_overlay";
+    case ProgramKind::depth:
+      return "depth";
+    case ProgramKind::depth_border:
+      return "depth_border";
   }
   return "unknown";
 }
 
-bool takes_subsamples(ProgramKind kind) { return kind == ProgramKind::elemental || kind == ProgramKind::border; }
+bool takes_subsamples(ProgramKind kind) {
+  return kind == ProgramKind::elemental || kind == ProgramKind::border || kind == ProgramKind::depth ||
+         kind == ProgramKind::depth_border;
+}
 
 }  // namespace
 
@@ -57,6 +64,10 @@ ProgramSource program_source(ProgramKind kind, int subsamples) {
       return {"fullscreen.vert", "prefilter_box.frag", {}};
     case ProgramKind::text_overlay:
       return {"fullscreen.vert", "text_overlay.frag", {}};
+    case ProgramKind::depth:
+      return {"fullscreen.vert", "elemental.frag", per_axis + "#define NELF_DEPTH 1\n"};
+    case ProgramKind::depth_border:
+      return {"border_strips.vert", "elemental.frag", per_axis + "#define NELF_AREA_SAMPLE 1\n#define NELF_DEPTH 1\n"};
   }
   throw std::invalid_argument("program_source: unknown program kind");
 }

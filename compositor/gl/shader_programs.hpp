@@ -19,10 +19,13 @@ enum class ProgramKind {
   reduce,        // footprint prefilter, step 1: block means
   box,           // footprint prefilter, step 2: one box per axis
   text_overlay,  // labels drawn into the packed frame
+  depth,         // pass 1 of the depth-aware composite: point samples where each ray meets the content
+  depth_border,  // its pass 2: area samples along the borders, each part where its ray meets the content
 };
 inline constexpr std::array every_program_kind = {
-    ProgramKind::elemental, ProgramKind::border, ProgramKind::map, ProgramKind::record,
-    ProgramKind::lookup,    ProgramKind::reduce, ProgramKind::box, ProgramKind::text_overlay,
+    ProgramKind::elemental, ProgramKind::border,       ProgramKind::map, ProgramKind::record,
+    ProgramKind::lookup,    ProgramKind::reduce,       ProgramKind::box, ProgramKind::text_overlay,
+    ProgramKind::depth,     ProgramKind::depth_border,
 };
 
 struct ProgramSource {

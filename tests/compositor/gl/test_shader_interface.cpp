@@ -64,7 +64,8 @@ const std::vector<std::pair<const char*, std::size_t>>& mapping_members() {
 }
 
 TEST(ShaderInterface, EveryMappingProgramHasTheBlockAsTheMirrorLaysItOut) {
-  for (ProgramKind kind : {ProgramKind::elemental, ProgramKind::border, ProgramKind::map, ProgramKind::record}) {
+  for (ProgramKind kind : {ProgramKind::elemental, ProgramKind::border, ProgramKind::map, ProgramKind::record,
+                           ProgramKind::depth, ProgramKind::depth_border}) {
     for (int subsamples : shaders::subsample_counts) {
       SCOPED_TRACE(testing::Message() << "program " << static_cast<int>(kind) << ", " << subsamples << " sub-samples");
       const gl::Program p = link(kind, subsamples);
@@ -110,6 +111,15 @@ TEST(ShaderInterface, UniformLocationsAndTextureUnitsAreTheDeclaredOnes) {
   EXPECT_EQ(glGetUniformLocation(box.id(), "u_out_origin"), at::box::out_origin);
   EXPECT_EQ(glGetUniformLocation(box.id(), "u_view_extent"), at::box::view_extent);
   EXPECT_EQ(sampler_unit(box.id(), "u_input"), static_cast<GLint>(shaders::view_unit));
+
+  for (ProgramKind kind : {ProgramKind::depth, ProgramKind::depth_border}) {
+    const gl::Program depth = link(kind, 2);
+    EXPECT_EQ(glGetUniformLocation(depth.id(), "u_parallax_gain"), at::depth::parallax_gain);
+    EXPECT_EQ(glGetUniformLocation(depth.id(), "u_disparity_range"), at::depth::disparity_range);
+    EXPECT_EQ(glGetUniformLocation(depth.id(), "u_pupil_per_lens"), at::depth::pupil_per_lens);
+    EXPECT_EQ(sampler_unit(depth.id(), "u_view"), static_cast<GLint>(shaders::view_unit));
+    EXPECT_EQ(sampler_unit(depth.id(), "u_disparity"), static_cast<GLint>(shaders::disparity_unit));
+  }
 
   const gl::Program text = link(ProgramKind::text_overlay);
   EXPECT_EQ(glGetUniformLocation(text.id(), "u_box_origin"), at::text_box_origin);

@@ -1,0 +1,92 @@
+#include "optics/depth.hpp"
+
+#include <fmt/format.h>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace nelf {
+
+DepthGeometry depth_geometry(const Profile& profile, const EyeMapping& mapping) {
+  return {mapping.render_distance_mm, mapping.screen_size_mm, profile.viewing.ipd_mm};
+}
+
+double disparity_mm_from_depth(const DepthGeometry& g, double depth_mm) {
+  return g.ipd_mm * (g.screen_distance_mm / depth_mm - 1.0);
+}
+
+double depth_mm_from_disparity(const DepthGeometry& g, double disparity_mm) {
+  const double inverse = (1.0 + disparity_mm / g.ipd_mm) / g.screen_distance_mm;
+  return inverse > 0.0 ? 1.0 / inverse : std::numeric_limits<double>::infinity();
+}
+
+Vec2 pupil_gain(const DepthGeometry& g, Vec2 pupil_mm) {
+  return {pupil_mm.x / g.ipd_mm, -pupil_mm.y * g.screen_size_mm.x / (g.ipd_mm * g.screen_size_mm.y)};
+}
+
+DisparitySurface::DisparitySurface(const ViewDisparity& disparity)
+    : width_(disparity.width), height_(disparity.height) {
+  if (width_ <= 0 || height_ <= 0 ||
+      disparity.d.size() != static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_))
+    throw std::invalid_argument(
+        fmt::format("disparity map of {}x{} with {} values", width_, height_, disparity.d.size()));
+  values_.resize(disparity.d.size());
+  const float to_screen = 1.0f / static_cast<float>(width_);  // map pixels to fractions of the screen's width
+  bool any = false;
+  for (int y = 0; y < height_; ++y) {
+    const float* in = disparity.d.data() + static_cast<std::size_t>(y) * width_;
+    float* out = values_.data() + static_cast<std::size_t>(y) * width_;
+    // Nearest known texel of the row: a left-to-right pass, then right-to-left for the texels
+    // nearer to a known one on their right.
+    std::vector<int> distance(static_cast<std::size_t>(width_), std::numeric_limits<int>::max());
+    int last = -1;
+    for (int x = 0; x < width_; ++x) {
+      if (std::isfinite(in[x])) last = x;
+      if (last >= 0) out[x] = in[last] * to_screen, distance[x] = x - last;
+    }
+    last = -1;
+    for (int x = width_ - 1; x >= 0; --x) {
+      if (std::isfinite(in[x])) last = x;
+      if (last >= 0 && last - x < distance[x]) out[x] = in[last] * to_screen, distance[x] = last - x;
+    }
+    for (int x = 0; x < width_; ++x)
+      if (distance[x] == std::numeric_limits<int>::max())
+        out[x] = 0.f;
+      else
+        any = true;
+  }
+  unknown_ = !any;
+  const auto [lo, hi] = std::minmax_element(values_.begin(), values_.end());
+  back_ = *lo;
+  front_ = *hi;
+}
+
+float DisparitySurface::at(Vec2 uv) const {
+  const int x = std::clamp(static_cast<int>(std::floor(uv.x * width_)), 0, width_ - 1);
+  const int y = std::clamp(static_cast<int>(std::floor(uv.y * height_)), 0, height_ - 1);
+  return values_[static_cast<std::size_t>(y) * width_ + x];
+}
+
+Vec2 DisparitySurface::hit(Vec2 flat_uv, Vec2 gain) const {
+  const auto along = [&](double d) { return Vec2{flat_uv.x + gain.x * d, flat_uv.y + gain.y * d}; };
+  const auto meets = [&](double d) { return at(along(d)) >= d; };  // the ray is at or behind the surface
+  const double front = front_, back = back_;
+  if (!(front > back) || meets(front)) return along(front);
+  double hit = back, before = front;
+  for (int i = 1; i <= depth_search_steps; ++i) {
+    const double d = front - (front - back) * i / depth_search_steps;
+    if (meets(d)) {
+      hit = d;
+      break;
+    }
+    before = d;
+  }
+  for (int k = 0; k < depth_search_bisections; ++k) {
+    const double mid = 0.5 * (hit + before);
+    (meets(mid) ? hit : before) = mid;
+  }
+  return along(hit);
+}
+
+}  // namespace nelf

@@ -1,0 +1,85 @@
+#pragma once
+// The content's depth, as the compositor and the eye simulator use it: the disparity of a view
+// (core/view_disparity.hpp) turned into distance with the emulated screen's geometry, and the
+// search along a ray for where it meets the content's surface. Pure math, shared by the CPU paths
+// and mirrored by shaders/elemental.frag (NELF_DEPTH).
+//
+// Geometry. Both eyes look at the emulated screen at distance D (render distance d_r) from their
+// pupils, their centres an IPD e apart. A scene point at distance Z seen by the left eye at screen
+// position x_L and by the right eye at x_R has the screen disparity δ = x_L − x_R = e (D/Z − 1) (mm
+// on the screen): 0 on the screen, > 0 in front of it, → −e at infinity. So 1/Z = (1 + δ/e)/D.
+//
+// A ray that crosses the pupil plane at p (mm, this eye's coordinates) and meets the flat screen at
+// v shows, in a view taken from the pupil's centre, the scene point at the screen position
+// v + p δ/e, where δ is the disparity of the surface there: the view seen from a pupil point p is
+// the view from the centre shifted by p/e of its disparity (p = ±e is the other eye's view). The
+// front-most δ with δ = disparity(v + p δ/e) is where the ray meets the surface.
+#include <cstddef>
+#include <vector>
+
+#include "core/view_disparity.hpp"
+#include "optics/mapping.hpp"
+
+namespace nelf {
+
+// The screen geometry the conversion needs: D, the screen's size (mm) and e.
+struct DepthGeometry {
+  double screen_distance_mm = 0;
+  Vec2 screen_size_mm;
+  double ipd_mm = 0;
+};
+
+// The geometry of `mapping` (a lens-array eye) under `profile`'s IPD.
+DepthGeometry depth_geometry(const Profile& profile, const EyeMapping& mapping);
+
+// δ (mm on the screen) of a point at distance `depth_mm` from the pupil; and back (+inf for δ ≤ −e:
+// at or beyond infinity).
+double disparity_mm_from_depth(const DepthGeometry& g, double depth_mm);
+double depth_mm_from_disparity(const DepthGeometry& g, double disparity_mm);
+
+// A view's disparity as a surface the compositor searches: per map texel the disparity in units of
+// the screen's width (δ / W; what the shader's texture holds), unknown texels (NaN) filled from
+// the nearest known one of their row (a row with none: the screen, 0), and the range of the values.
+class DisparitySurface {
+ public:
+  // Throws std::invalid_argument for a map whose size does not match its values or is empty.
+  explicit DisparitySurface(const ViewDisparity& disparity);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const std::vector<float>& values() const { return values_; }  // row-major, δ / W
+  float front() const { return front_; }                        // the largest value (nearest)
+  float back() const { return back_; }                          // the smallest value (farthest)
+  // True when every texel was unknown (the surface is then the flat screen).
+  bool unknown() const { return unknown_; }
+
+  // The value at screen coordinate uv (u right, t down, in [0, 1]; clamped to the map), nearest texel.
+  float at(Vec2 uv) const;
+
+  // Where on the screen (uv) a ray shows the surface: the ray meets the flat screen at `flat_uv` and
+  // shifts by `gain` (uv) per unit of δ / W (pupil_gain of its pupil-plane crossing). The front-most
+  // crossing, found by `depth_search_steps` steps from the front to the back and a bisection of the
+  // step that crosses. A surface of one value v gives flat_uv + gain · v exactly (0: flat_uv).
+  Vec2 hit(Vec2 flat_uv, Vec2 gain) const;
+
+ private:
+  int width_ = 0, height_ = 0;
+  std::vector<float> values_;
+  float front_ = 0.f, back_ = 0.f;
+  bool unknown_ = false;
+};
+
+// Steps of the search from front to back, and bisections of the crossing step (the shader's too).
+inline constexpr int depth_search_steps = 24;
+inline constexpr int depth_search_bisections = 6;
+
+// The uv shift per unit of δ / W of a ray crossing the pupil plane at `pupil_mm`: (p_x / e, −p_y W / (e H)).
+Vec2 pupil_gain(const DepthGeometry& g, Vec2 pupil_mm);
+
+// Where the chief ray of display position s through lens centre c crosses the pupil plane.
+inline Vec2 chief_ray_pupil_crossing(const EyeMapping& m, Vec2 s, Vec2 c) {
+  const double k = m.eye_relief_mm / m.gap_mm;
+  return {c.x - (s.x - c.x) * k, c.y - (s.y - c.y) * k};
+}
+
+}  // namespace nelf
