@@ -34,13 +34,27 @@ cv::Mat luma_block_means(const std::vector<std::uint8_t>& view, int bits, int pw
   const int ow = pw / k, oh = ph / k;
   cv::Mat out(oh, ow, CV_8UC1);
   const std::size_t row_bytes = static_cast<std::size_t>(pw) * bytes_per_pixel(bits);
-  const std::uint32_t divisor = static_cast<std::uint32_t>(k * k) * 256;
+  const float to_gray = 1.f / (static_cast<float>(k * k) * 256.f);
   cv::parallel_for_(cv::Range(0, oh), [&](const cv::Range& rows) {
     std::vector<std::uint32_t> sums(static_cast<std::size_t>(ow));
     for (int oy = rows.start; oy < rows.end; ++oy) {
+      auto* dst = out.ptr<std::uint8_t>(oy);
+      const std::uint8_t* top = view.data() + static_cast<std::size_t>(oy * k) * row_bytes;
+      if (bits <= 8 && k == 2) {  // the common case (a 1080p view to the guide), kept vectorisable
+        const std::uint8_t* bottom = top + row_bytes;
+        for (int ox = 0; ox < ow; ++ox) {
+          const std::uint8_t* a = top + static_cast<std::size_t>(ox) * 8;
+          const std::uint8_t* b = bottom + static_cast<std::size_t>(ox) * 8;
+          const std::uint32_t r = std::uint32_t{a[0]} + a[4] + b[0] + b[4];
+          const std::uint32_t g = std::uint32_t{a[1]} + a[5] + b[1] + b[5];
+          const std::uint32_t bl = std::uint32_t{a[2]} + a[6] + b[2] + b[6];
+          dst[ox] = static_cast<std::uint8_t>((luma_256(r, g, bl) + 512) >> 10);
+        }
+        continue;
+      }
       std::fill(sums.begin(), sums.end(), 0u);
       for (int dy = 0; dy < k; ++dy) {
-        const std::uint8_t* row = view.data() + static_cast<std::size_t>(oy * k + dy) * row_bytes;
+        const std::uint8_t* row = top + static_cast<std::size_t>(dy) * row_bytes;
         if (bits > 8) {
           for (int ox = 0; ox < ow; ++ox) {
             std::uint32_t s = 0;
@@ -60,8 +74,8 @@ cv::Mat luma_block_means(const std::vector<std::uint8_t>& view, int bits, int pw
           }
         }
       }
-      auto* dst = out.ptr<std::uint8_t>(oy);
-      for (int ox = 0; ox < ow; ++ox) dst[ox] = static_cast<std::uint8_t>(sums[static_cast<std::size_t>(ox)] / divisor);
+      for (int ox = 0; ox < ow; ++ox)
+        dst[ox] = static_cast<std::uint8_t>(static_cast<float>(sums[static_cast<std::size_t>(ox)]) * to_gray);
     }
   });
   return out;
@@ -165,37 +179,53 @@ ViewDisparity upsample(const cv::Mat& d, const cv::Mat& low, const cv::Mat& guid
   ViewDisparity out;
   out.width = guide.cols;
   out.height = guide.rows;
-  out.d.assign(static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height), unknown);
+  out.d.resize(static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height));
   const float scale = static_cast<float>(guide.cols) / static_cast<float>(d.cols);
-  const float sx = static_cast<float>(d.cols) / static_cast<float>(guide.cols);
-  const float sy = static_cast<float>(d.rows) / static_cast<float>(guide.rows);
+  // Where each output column and row falls between the samples of `d`.
+  struct Tap {
+    int i0, i1;
+    float w;
+  };
+  const auto taps = [](int out_size, int in_size) {
+    std::vector<Tap> t(static_cast<std::size_t>(out_size));
+    const float step = static_cast<float>(in_size) / static_cast<float>(out_size);
+    for (int o = 0; o < out_size; ++o) {
+      const float f = std::clamp((static_cast<float>(o) + .5f) * step - .5f, 0.f, static_cast<float>(in_size - 1));
+      const int i0 = static_cast<int>(f);
+      t[static_cast<std::size_t>(o)] = {i0, std::min(i0 + 1, in_size - 1), f - static_cast<float>(i0)};
+    }
+    return t;
+  };
+  const std::vector<Tap> columns = taps(guide.cols, d.cols), rows_at = taps(guide.rows, d.rows);
   std::array<float, 256> similarity{};
   constexpr float sigma = 10.f;
   for (int i = 0; i < 256; ++i)
     similarity[static_cast<std::size_t>(i)] = std::exp(-static_cast<float>(i * i) / (2 * sigma * sigma)) + 1e-4f;
   cv::parallel_for_(cv::Range(0, guide.rows), [&](const cv::Range& rows) {
     for (int y = rows.start; y < rows.end; ++y) {
-      const float fy = std::clamp((static_cast<float>(y) + .5f) * sy - .5f, 0.f, static_cast<float>(d.rows - 1));
-      const int y0 = static_cast<int>(fy), y1 = std::min(y0 + 1, d.rows - 1);
-      const float wy = fy - static_cast<float>(y0);
-      const auto* g = guide.ptr<std::uint8_t>(y);
+      const Tap ty = rows_at[static_cast<std::size_t>(y)];
+      const float* d0 = d.ptr<float>(ty.i0);
+      const float* d1 = d.ptr<float>(ty.i1);
+      const std::uint8_t* l0 = low.ptr<std::uint8_t>(ty.i0);
+      const std::uint8_t* l1 = low.ptr<std::uint8_t>(ty.i1);
+      const std::uint8_t* g = guide.ptr<std::uint8_t>(y);
       float* dst = out.d.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width);
       for (int x = 0; x < guide.cols; ++x) {
-        const float fx = std::clamp((static_cast<float>(x) + .5f) * sx - .5f, 0.f, static_cast<float>(d.cols - 1));
-        const int x0 = static_cast<int>(fx), x1 = std::min(x0 + 1, d.cols - 1);
-        const float wx = fx - static_cast<float>(x0);
-        const std::array<std::array<int, 2>, 4> taps{{{y0, x0}, {y0, x1}, {y1, x0}, {y1, x1}}};
-        const std::array<float, 4> spatial{(1 - wy) * (1 - wx), (1 - wy) * wx, wy * (1 - wx), wy * wx};
-        float sum = 0, weights = 0;
-        for (std::size_t t = 0; t < 4; ++t) {
-          const float v = d.at<float>(taps[t][0], taps[t][1]);
-          if (std::isnan(v) || spatial[t] <= 0) continue;
-          const int difference = std::abs(int{g[x]} - int{low.at<std::uint8_t>(taps[t][0], taps[t][1])});
-          const float w = spatial[t] * similarity[static_cast<std::size_t>(difference)];
-          sum += w * v;
-          weights += w;
-        }
-        if (weights > 0) dst[x] = sum / weights * scale;
+        const Tap tx = columns[static_cast<std::size_t>(x)];
+        const int level = g[x];
+        const auto weight = [&](float v, std::uint8_t sample_level, float spatial) {
+          return std::isnan(v) ? 0.f
+                               : spatial * similarity[static_cast<std::size_t>(std::abs(level - int{sample_level}))];
+        };
+        const float v00 = d0[tx.i0], v01 = d0[tx.i1], v10 = d1[tx.i0], v11 = d1[tx.i1];
+        const float w00 = weight(v00, l0[tx.i0], (1 - ty.w) * (1 - tx.w));
+        const float w01 = weight(v01, l0[tx.i1], (1 - ty.w) * tx.w);
+        const float w10 = weight(v10, l1[tx.i0], ty.w * (1 - tx.w));
+        const float w11 = weight(v11, l1[tx.i1], ty.w * tx.w);
+        const float weights = w00 + w01 + w10 + w11;
+        const float sum = (w00 > 0 ? w00 * v00 : 0.f) + (w01 > 0 ? w01 * v01 : 0.f) + (w10 > 0 ? w10 * v10 : 0.f) +
+                          (w11 > 0 ? w11 * v11 : 0.f);
+        dst[x] = weights > 0 ? sum / weights * scale : unknown;
       }
     }
   });
