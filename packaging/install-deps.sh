@@ -16,6 +16,8 @@ packages=(
   # media: FFmpeg libraries, the ffmpeg CLI for test media and benchmarks, OpenImageIO
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libswresample-dev libavfilter-dev
   ffmpeg libopenimageio-dev libpng-dev
+  # stereo matching for the estimated depth (inputs/stereo_matcher): OpenCV's block matcher
+  libopencv-dev
   # maths, configuration, CLI, formatting, JSON, audio
   libglm-dev libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libsdl2-dev
   # tests (zsh and fish: the completion checks run them)
