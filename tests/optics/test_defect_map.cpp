@@ -87,9 +87,8 @@ TEST(DefectMap, MissingFileIsOneLine) {
   }
 }
 
-const char* profile_with_map(const std::string& map) {
-  static std::string text;
-  text = R"(name = "t"
+std::string profile_with_map(const std::string& map) {
+  return R"(name = "t"
 [display]
 resolution = [1280, 720]
 pixel_pitch_mm = 0.012
@@ -102,7 +101,6 @@ virtual_image_mm = 1000.0
 [correction]
 defect_map = ")" +
          map + "\"\n";
-  return text.c_str();
 }
 
 TEST(DefectMap, LoadedWithTheProfileRelativeToIt) {
