@@ -54,6 +54,23 @@ struct DefectPlanOptions {
 EyeDefectPlan plan_defect_compensation(const EyeMapping& mapping, const DefectMap& map,
                                        const DefectPlanOptions& options = {});
 
+// The plan's eye box (Eq. 9 with the emulated screen's distance, per axis the same: square lenses):
+// the pupil-plane extent, centred on the design pupil, from which every elemental image is seen
+// through its own lens. 0 for a stock device.
+double eye_box_width_mm(const EyeMapping& mapping);
+
+// The pupil centres the plan keeps the retina right for: an n × n grid over the positions where a
+// pupil of `pupil_mm` lies wholly inside the eye box (a single central position when it does not
+// fit). The eye simulator's defect measurement uses the same grid.
+std::vector<Vec2> eye_box_pupil_positions(const EyeMapping& mapping, double pupil_mm, int per_axis);
+
+// The candidate pixels of the ray bundle of pixel (x, y) before other defects are taken out: for
+// each lit lens within two pitches of the pixel's own, the 2 × 2 pixels around where that lens's
+// elemental image shows the pixel's screen point. Empty outside the lit elemental images and for a
+// stock device. A defect whose pupil-plane beam no position of the eye box sees gets no correction
+// and is counted neither as outside_lit nor as uncompensable.
+std::vector<std::array<int, 2>> defect_bundle_pixels(const EyeMapping& mapping, int x, int y);
+
 // Per frame, in place, on one eye's composited image (panel size; the defects' own pixels are left
 // as they are, the display shows what it shows there). All corrections are worked out from the
 // image as it was given, so shares that meet on one pixel add up.
