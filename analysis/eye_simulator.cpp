@@ -200,41 +200,78 @@ EyeSimulator::EyeSimulator(DeviceOptics device, const EyeMapping& rendering, con
 // Both images share the ray set: from each pupil point P (offset + sample ρ) towards the in-focus point
 // F = offset + d_a (tan θx, tan θy), i.e. slope (tan θ) − ρ/d_a (ρ/∞ = 0 for the relaxed eye).
 
-Image EyeSimulator::retina(const Image& displayed, const EyeModel& eye) const {
+// What one retinal pixel (i, j) collects over the pupil: the per-call constants of retina(), once.
+struct EyeSimulator::RetinaTrace {
+  const EyeSimulator& sim;
+  const Image& displayed;
+  const EyeModel& eye;
+  std::vector<Vec2> pupil;
+  double inv_focus, d_e, d_l, pitch, inv_f, cos_t, sin_t, half_w, half_h, weight;
+  Vec2 o;
+
+  RetinaTrace(const EyeSimulator& s, const Image& image, const EyeModel& e)
+      : sim(s), displayed(image), eye(e), pupil(pupil_samples(e.pupil_mm, e.pupil_samples_per_axis)) {
+    const DeviceOptics& device = sim.device_;
+    inv_focus = 1.0 / eye.focus_mm;
+    d_e = device.eye_relief_mm, d_l = device.gap_mm, pitch = device.lens_pitch_mm;
+    inv_f = 1.0 / device.focal_mm;
+    cos_t = std::cos(device.rotation_rad), sin_t = std::sin(device.rotation_rad);
+    o = device.lattice_offset_mm;
+    half_w = device.panel[0] / 2.0, half_h = device.panel[1] / 2.0;
+    weight = 1.0 / static_cast<double>(pupil.size());
+  }
+
+  Rgba operator()(int i, int j) const {
+    double r = 0, g = 0, b = 0;
+    for (const Vec2& rho : pupil) {
+      const double slope_x = sim.tan_x_[i] - rho.x * inv_focus, slope_y = sim.tan_y_[j] - rho.y * inv_focus;
+      // Hit point on the lens plane.
+      const double qx = eye.offset_mm.x + rho.x + slope_x * d_e, qy = eye.offset_mm.y + rho.y + slope_y * d_e;
+      // The lenslet whose square aperture contains it: every point of the (unbounded) sheet has one.
+      const double lx = cos_t * (qx - o.x) + sin_t * (qy - o.y), ly = -sin_t * (qx - o.x) + cos_t * (qy - o.y);
+      const double m = std::floor(lx / pitch + 0.5) * pitch, n = std::floor(ly / pitch + 0.5) * pitch;
+      const double cx = o.x + cos_t * m - sin_t * n, cy = o.y + sin_t * m + cos_t * n;
+      // Paraxial thin lens, then on to the display.
+      const double sx = qx + (slope_x - (qx - cx) * inv_f) * d_l, sy = qy + (slope_y - (qy - cy) * inv_f) * d_l;
+      const Rgba p = sample_bilinear_black_outside(displayed, sx / sim.device_.pixel_pitch_mm.x + half_w,
+                                                   half_h - sy / sim.device_.pixel_pitch_mm.y);
+      r += p.r, g += p.g, b += p.b;
+    }
+    return {static_cast<float>(r * weight), static_cast<float>(g * weight), static_cast<float>(b * weight), 1.f};
+  }
+};
+
+void EyeSimulator::check_displayed(const Image& displayed, const EyeModel& eye) const {
   validate_eye_model(eye);
   if (displayed.width() != device_.panel[0] || displayed.height() != device_.panel[1])
     throw std::invalid_argument(fmt::format("eye simulator: displayed image is {}x{}, the panel is {}x{}",
                                             displayed.width(), displayed.height(), device_.panel[0], device_.panel[1]));
-  const auto pupil = pupil_samples(eye.pupil_mm, eye.pupil_samples_per_axis);
-  const double inv_focus = 1.0 / eye.focus_mm;
-  const double d_e = device_.eye_relief_mm, d_l = device_.gap_mm, pitch = device_.lens_pitch_mm;
-  const double inv_f = 1.0 / device_.focal_mm;
-  const double cos_t = std::cos(device_.rotation_rad), sin_t = std::sin(device_.rotation_rad);
-  const Vec2 o = device_.lattice_offset_mm;
-  const double half_w = device_.panel[0] / 2.0, half_h = device_.panel[1] / 2.0;
-  const double weight = 1.0 / static_cast<double>(pupil.size());
+}
 
+Image EyeSimulator::retina(const Image& displayed, const EyeModel& eye) const {
+  check_displayed(displayed, eye);
+  const RetinaTrace trace(*this, displayed, eye);
   Image out(field_.width, field_.height);
   for_each_row(field_.height, [&](int j) {
-    for (int i = 0; i < field_.width; ++i) {
-      double r = 0, g = 0, b = 0;
-      for (const Vec2& rho : pupil) {
-        const double slope_x = tan_x_[i] - rho.x * inv_focus, slope_y = tan_y_[j] - rho.y * inv_focus;
-        // Hit point on the lens plane.
-        const double qx = eye.offset_mm.x + rho.x + slope_x * d_e, qy = eye.offset_mm.y + rho.y + slope_y * d_e;
-        // The lenslet whose square aperture contains it: every point of the (unbounded) sheet has one.
-        const double lx = cos_t * (qx - o.x) + sin_t * (qy - o.y), ly = -sin_t * (qx - o.x) + cos_t * (qy - o.y);
-        const double m = std::floor(lx / pitch + 0.5) * pitch, n = std::floor(ly / pitch + 0.5) * pitch;
-        const double cx = o.x + cos_t * m - sin_t * n, cy = o.y + sin_t * m + cos_t * n;
-        // Paraxial thin lens, then on to the display.
-        const double sx = qx + (slope_x - (qx - cx) * inv_f) * d_l, sy = qy + (slope_y - (qy - cy) * inv_f) * d_l;
-        const Rgba p = sample_bilinear_black_outside(displayed, sx / device_.pixel_pitch_mm.x + half_w,
-                                                     half_h - sy / device_.pixel_pitch_mm.y);
-        r += p.r, g += p.g, b += p.b;
-      }
-      out.at(i, j) = {static_cast<float>(r * weight), static_cast<float>(g * weight), static_cast<float>(b * weight),
-                      1.f};
-    }
+    for (int i = 0; i < field_.width; ++i) out.at(i, j) = trace(i, j);
+  });
+  return out;
+}
+
+std::vector<Rgba> EyeSimulator::retina_at(const Image& displayed, const EyeModel& eye,
+                                          const std::vector<std::array<int, 2>>& pixels) const {
+  check_displayed(displayed, eye);
+  for (const auto& p : pixels)
+    if (p[0] < 0 || p[1] < 0 || p[0] >= field_.width || p[1] >= field_.height)
+      throw std::invalid_argument(fmt::format("eye simulator: retinal pixel ({}, {}) is outside the {}x{} field", p[0],
+                                              p[1], field_.width, field_.height));
+  const RetinaTrace trace(*this, displayed, eye);
+  std::vector<Rgba> out(pixels.size());
+  constexpr int chunk = 256;  // pixels per task
+  const int chunks = static_cast<int>((pixels.size() + chunk - 1) / chunk);
+  for_each_row(chunks, [&](int c) {
+    const std::size_t end = std::min(pixels.size(), static_cast<std::size_t>(c + 1) * chunk);
+    for (std::size_t k = static_cast<std::size_t>(c) * chunk; k < end; ++k) out[k] = trace(pixels[k][0], pixels[k][1]);
   });
   return out;
 }

@@ -92,6 +92,10 @@ class EyeSimulator {
   // The two halves of simulate(), for callers that need only one.
   Image retina(const Image& displayed, const EyeModel& eye) const;
   Image ideal(const EyeModel& eye) const;
+  // The retina at the listed pixels (column, row) of the field only, traced as retina() traces them:
+  // for measurements that look at a few spots of the field with many pupil samples.
+  std::vector<Rgba> retina_at(const Image& displayed, const EyeModel& eye,
+                              const std::vector<std::array<int, 2>>& pixels) const;
   // 1 where the chief ray from the eye's pupil centre hits the emulated screen.
   std::vector<std::uint8_t> on_screen_mask(const EyeModel& eye) const;
   // 1 for the directions in which a pupil of `pupil_mm` at the design position, relaxed (the widest
@@ -107,6 +111,8 @@ class EyeSimulator {
   const Image& band_limited_view() const { return band_limited_view_; }
 
  private:
+  struct RetinaTrace;
+  void check_displayed(const Image& displayed, const EyeModel& eye) const;
   DeviceOptics device_;
   double render_distance_mm_;
   Vec2 screen_centre_mm_, screen_size_mm_;
