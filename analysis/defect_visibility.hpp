@@ -25,7 +25,7 @@ Image defective_display(const DefectMap& map, Eye eye, Image sent);
 Image compensated_display(const EyeDefectPlan& plan, const Image& sent);
 
 struct DefectSpotFigures {
-  int count = 0;  // defects whose spot lies in the simulator's evaluated field from some eye position
+  int count = 0;  // defects whose spot window lies wholly in the simulator's evaluated field from some eye position
   // Spot contrast of a defect seen from one eye position: the largest |defective − clean| / clean
   // luminance (mean of R, G, B; clean floored at contrast_floor) over its spot window. Worst and mean
   // over the defects and the eye positions.

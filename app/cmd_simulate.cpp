@@ -13,17 +13,19 @@
 #include <system_error>
 
 #include <fmt/ranges.h>
+#include "analysis/defect_visibility.hpp"
+#include "analysis/eye_simulator.hpp"
 #include "app/commands.hpp"
 #include "app/heatmap.hpp"
-#include "player/input_files.hpp"
-#include "analysis/eye_simulator.hpp"
 #include "compositor/make_compositor.hpp"
-#include "optics/mapping.hpp"
 #include "compositor/reference.hpp"
-#include "hmz_output/image_sink.hpp"
 #include "core/printable.hpp"
+#include "hmz_output/image_sink.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/synthetic_source.hpp"
+#include "optics/defect_compensation.hpp"
+#include "optics/mapping.hpp"
+#include "player/input_files.hpp"
 
 namespace nelf::app {
 
@@ -49,6 +51,7 @@ struct SimulateArgs {
   std::string ideal;
   std::string sweep;
   bool json = false;
+  bool no_defect_compensation = false;
   std::string layout = "auto";
   std::string right;
   bool swap_eyes = false;
@@ -219,8 +222,28 @@ void run_simulate(const SimulateArgs& args) {
     }
   }
   const EyeMapping rendering = make_eye_mapping(profile, eye, view.aspect());
-  const Image displayed = composite_eye_image(profile, eye, view);
+  // The defect-free display: the map is taken out of the profile here, so that the defects (and their
+  // compensation) are applied once, below, whatever the compositor does with a map.
+  Profile without_defects = profile;
+  without_defects.correction.defects.reset();
+  without_defects.correction.defect_map.clear();
+  without_defects.correction.defect_map_path.clear();
+  const Image clean = composite_eye_image(without_defects, eye, view);
   const EyeSimulator simulator(device, rendering, view.image);
+
+  // A panel with a defect map shows its defects, compensated unless asked not to; the retina and the
+  // PSNR are of what it shows.
+  const DefectMap* defects = profile.correction.defects.get();
+  std::optional<EyeDefectPlan> plan;
+  Image uncompensated, compensated;
+  if (defects) {
+    DefectPlanOptions plan_options;
+    plan_options.pupil_mm = eye_model.pupil_mm;
+    plan = plan_defect_compensation(rendering, *defects, plan_options);
+    uncompensated = defective_display(*defects, eye, clean);
+    if (!args.no_defect_compensation) compensated = defective_display(*defects, eye, compensated_display(*plan, clean));
+  }
+  const Image& displayed = !defects ? clean : args.no_defect_compensation ? uncompensated : compensated;
   const SimulationResult result = simulator.simulate(displayed, eye_model);
 
   if (!args.sweep.empty()) run_sweep(args, profile, eye, view, eye_model, args.sweep);
@@ -232,6 +255,49 @@ void run_simulate(const SimulateArgs& args) {
   }
 
   const auto finite_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  // The defects' visibility: the display as shown (and, when compensated, also without the
+  // compensation) against the defect-free one.
+  nlohmann::json defect_json;
+  std::string defect_line;
+  if (defects) {
+    std::vector<PixelDefect> of_eye;
+    for (const PixelDefect& d : defects->defects)
+      if (d.eye == eye) of_eye.push_back(d);
+    std::vector<const Image*> displays{&displayed};
+    if (!args.no_defect_compensation) displays.push_back(&uncompensated);
+    const auto visibility =
+        measure_defect_visibility(simulator, rendering, of_eye, clean, displays, eye_model.pupil_mm);
+    const auto spots = [](const DefectSpotFigures& f) {
+      return nlohmann::json{{"count", f.count},
+                            {"worst_spot_contrast", f.worst_spot_contrast},
+                            {"mean_spot_contrast", f.mean_spot_contrast}};
+    };
+    const auto figures = [&](const DefectVisibility& v) {
+      nlohmann::json j{{"measured", v.all.count},
+                       {"worst_spot_contrast", v.all.worst_spot_contrast},
+                       {"mean_spot_contrast", v.all.mean_spot_contrast},
+                       {"defect_psnr_db", finite_or_null(v.defect_psnr_db)},
+                       {"dead", spots(v.dead)},
+                       {"stuck", spots(v.stuck)}};
+      return j;
+    };
+    defect_json = figures(visibility[0]);
+    defect_json["count"] = of_eye.size();
+    defect_json["outside_lit"] = plan->outside_lit;
+    defect_json["uncompensable"] = plan->uncompensable;
+    defect_json["compensated"] = !args.no_defect_compensation;
+    if (!args.no_defect_compensation) defect_json["uncompensated"] = figures(visibility[1]);
+    defect_line = fmt::format(
+        "{} defects ({} outside the lit elemental images, {} uncompensable), {}: worst spot contrast {:.2f}%, mean "
+        "{:.2f}%, defect PSNR {:.2f} dB",
+        of_eye.size(), plan->outside_lit, plan->uncompensable,
+        args.no_defect_compensation ? "not compensated" : "compensated", 100 * visibility[0].all.worst_spot_contrast,
+        100 * visibility[0].all.mean_spot_contrast, visibility[0].defect_psnr_db);
+    if (!args.no_defect_compensation)
+      defect_line += fmt::format(" (without compensation {:.2f}%, {:.2f}%, {:.2f} dB)",
+                                 100 * visibility[1].all.worst_spot_contrast,
+                                 100 * visibility[1].all.mean_spot_contrast, visibility[1].defect_psnr_db);
+  }
   if (args.json) {
     nlohmann::json j;
     j["psnr_db"] = finite_or_null(result.psnr_db);
@@ -242,6 +308,7 @@ void run_simulate(const SimulateArgs& args) {
     j["psnr_full_screen_db"] = finite_or_null(result.psnr_full_screen_db);
     j["evaluated_fraction"] = result.evaluated_fraction;
     j["retina_size"] = {result.retina.width(), result.retina.height()};
+    if (defects) j["defects"] = defect_json;
     fmt::print("{}\n", j.dump());
   } else {
     fmt::print(
@@ -249,6 +316,7 @@ void run_simulate(const SimulateArgs& args) {
         "the clear field, {:.2f} dB over all of it)\n",
         result.psnr_db, args.eye, distance_label(eye_model.focus_mm), eye_model.pupil_mm, eye_model.offset_mm.x,
         eye_model.offset_mm.y, 100 * result.evaluated_fraction, result.psnr_full_screen_db);
+    if (defects) fmt::print("{}\n", defect_line);
   }
 }
 
@@ -278,6 +346,8 @@ void add_simulate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--output,-o", args->output, "Retinal image to write (PNG)")->required();
   cmd->add_option("--ideal", args->ideal, "Also write the ideal image (the eye looking at the screen)");
+  cmd->add_flag("--no-defect-compensation", args->no_defect_compensation,
+                "Show the profile's defect map uncompensated (the defects' figures then lack the comparison)");
   cmd->add_flag("--json", args->json, "Print one JSON object: psnr_db, focus_mm (null = infinity), pupil_mm, ...");
   cmd->add_option("--sweep", args->sweep,
                   "Also tabulate PSNR over screen distance (0.25-4 D) x accommodation (0-4 D) into this CSV and draw "
