@@ -132,16 +132,17 @@ std::vector<DefectVisibility> measure_defect_visibility(const EyeSimulator& simu
         const int i = static_cast<int>(std::floor((x_deg - field.left_deg) / field.step_deg));
         const int j = static_cast<int>(std::floor((field.top_deg - y_deg) / field.step_deg));
         if (i < 0 || j < 0 || i >= field.width || j >= field.height) continue;
-        // Only spots wholly inside the evaluated field: at the screen's edge the clean retina itself
-        // fades to black and a contrast against it says nothing about the defect.
-        if (i < radius || j < radius || i + radius >= field.width || j + radius >= field.height) continue;
-        bool inside = true;
+        // Every spot's error counts for the PSNR; its contrast only where the window lies wholly in the
+        // evaluated field: at the screen's edge the clean retina itself fades to black and a contrast
+        // against it says nothing about the defect.
+        bool inside = i >= radius && j >= radius && i + radius < field.width && j + radius < field.height;
         for (int y = j - radius; inside && y <= j + radius; ++y)
           for (int x = i - radius; inside && x <= i + radius; ++x)
             inside = evaluated[static_cast<std::size_t>(y) * field.width + x] != 0;
-        if (!inside) continue;
-        spots.push_back({n, i, j});
-        measured[n] = true;
+        if (inside) {
+          spots.push_back({n, i, j});
+          measured[n] = true;
+        }
         for (int y = std::max(0, j - radius); y <= std::min(field.height - 1, j + radius); ++y) {
           for (int x = std::max(0, i - radius); x <= std::min(field.width - 1, i + radius); ++x) {
             const std::size_t p = static_cast<std::size_t>(y) * field.width + x;
