@@ -56,7 +56,8 @@ struct DefectMeasurementOptions {
 // for the defects `defects` (of the simulator's eye), seen by an eye of pupil `pupil_mm`. `rendering`
 // is the mapping the displays were composited with (it places the defects' screen points). One
 // result per display, in order. The error is gathered at the spot windows: seen from inside the eye
-// box a pixel reaches the retina only around its own screen point, so elsewhere the displays agree.
+// box a pixel reaches the retina only around its own screen point, so elsewhere the displays agree
+// (but for light crossing to a neighbouring lens at the eye box's edge, docs/defects.md).
 std::vector<DefectVisibility> measure_defect_visibility(const EyeSimulator& simulator, const EyeMapping& rendering,
                                                         const std::vector<PixelDefect>& defects, const Image& clean,
                                                         const std::vector<const Image*>& displays, double pupil_mm,
