@@ -70,13 +70,12 @@ Rgb shown(const PixelDefect& defect) {
 }
 
 // The shares of every correction, from `read(x, y)` (0..1 per channel, the image as given),
-// summed per pixel index (y · panel width + x).
-template <class Read>
-ShareSums sum_shares(const EyeDefectPlan& plan, Read&& read) {
+// summed per `key(x, y)` (where the pixel is: an index, or a byte offset).
+template <class Read, class Key>
+ShareSums sum_shares(const EyeDefectPlan& plan, Read&& read, Key&& key) {
   std::size_t shares = 0;
   for (const auto& correction : plan.corrections) shares += correction.shares.size();
   ShareSums sums(shares);
-  const auto width = static_cast<std::size_t>(plan.panel[0]);
   for (const auto& correction : plan.corrections) {
     const PixelDefect& defect = correction.defect;
     if (correction.shares.empty() || !inside(plan.panel, defect.x, defect.y)) continue;
@@ -85,9 +84,7 @@ ShareSums sum_shares(const EyeDefectPlan& plan, Read&& read) {
     const Rgb difference{sent[0] - seen[0], sent[1] - seen[1], sent[2] - seen[2]};
     if (difference[0] == 0.f && difference[1] == 0.f && difference[2] == 0.f) continue;
     for (const auto& share : correction.shares)
-      if (inside(plan.panel, share.x, share.y))
-        sums.add(static_cast<std::size_t>(share.y) * width + static_cast<std::size_t>(share.x), share.weight,
-                 difference);
+      if (inside(plan.panel, share.x, share.y)) sums.add(key(share.x, share.y), share.weight, difference);
   }
   return sums;
 }
@@ -95,23 +92,22 @@ ShareSums sum_shares(const EyeDefectPlan& plan, Read&& read) {
 template <class Channel>
 void compensate_channels(const EyeDefectPlan& plan, std::uint8_t* rgba, std::size_t row_bytes) {
   constexpr float full = static_cast<float>(std::numeric_limits<Channel>::max());
-  const auto pixel_at = [&](int x, int y) {
-    return rgba + static_cast<std::size_t>(y) * row_bytes + static_cast<std::size_t>(x) * 4 * sizeof(Channel);
+  const auto offset = [&](int x, int y) {
+    return static_cast<std::size_t>(y) * row_bytes + static_cast<std::size_t>(x) * 4 * sizeof(Channel);
   };
   const auto read = [&](int x, int y) {
     Channel channels[3];
-    std::memcpy(channels, pixel_at(x, y), sizeof(channels));
+    std::memcpy(channels, rgba + offset(x, y), sizeof(channels));
     return Rgb{channels[0] / full, channels[1] / full, channels[2] / full};
   };
-  const ShareSums sums = sum_shares(plan, read);
-  const auto width = static_cast<std::size_t>(plan.panel[0]);
-  sums.for_each([&](std::size_t pixel, const Rgb& sum) {
-    std::uint8_t* at = pixel_at(static_cast<int>(pixel % width), static_cast<int>(pixel / width));
+  const ShareSums sums = sum_shares(plan, read, offset);
+  sums.for_each([&](std::size_t at, const Rgb& sum) {
     Channel channels[3];
-    std::memcpy(channels, at, sizeof(channels));
+    std::memcpy(channels, rgba + at, sizeof(channels));
+    // Clipped to 0..1 first, so + 0.5 rounds to nearest.
     for (int c = 0; c < 3; ++c)
-      channels[c] = static_cast<Channel>(std::lround(std::clamp(channels[c] / full + sum[c], 0.f, 1.f) * full));
-    std::memcpy(at, channels, sizeof(channels));
+      channels[c] = static_cast<Channel>(std::clamp(channels[c] / full + sum[c], 0.f, 1.f) * full + 0.5f);
+    std::memcpy(rgba + at, channels, sizeof(channels));
   });
 }
 
@@ -122,10 +118,16 @@ void compensate_defects(const EyeDefectPlan& plan, Image& eye) {
   if (eye.width() != plan.panel[0] || eye.height() != plan.panel[1])
     throw std::invalid_argument(fmt::format("compensate_defects: a plan for a {}x{} panel given a {}x{} image",
                                             plan.panel[0], plan.panel[1], eye.width(), eye.height()));
-  const ShareSums sums = sum_shares(plan, [&](int x, int y) {
-    const Rgba& p = eye.at(x, y);
-    return Rgb{p.r, p.g, p.b};
-  });
+  const auto index = [&](int x, int y) {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(eye.width()) + static_cast<std::size_t>(x);
+  };
+  const ShareSums sums = sum_shares(
+      plan,
+      [&](int x, int y) {
+        const Rgba& p = eye.at(x, y);
+        return Rgb{p.r, p.g, p.b};
+      },
+      index);
   auto& pixels = eye.pixels();
   sums.for_each([&](std::size_t pixel, const Rgb& sum) {
     Rgba& p = pixels[pixel];
