@@ -50,8 +50,13 @@ GlDefectCompensation::GlDefectCompensation()
 
 void GlDefectCompensation::prepare(EyeBuffers& eye, const std::shared_ptr<const EyeDefectPlan>& plan) {
   if (eye.made_for == plan) return;
+  eye.adding_only = eye.subtracting_only = 0;
   const auto inside = [&](int x, int y) { return x >= 0 && y >= 0 && x < plan->panel[0] && y < plan->panel[1]; };
   std::vector<GpuDefect> defects;
+  // Per defect, whether its difference (what it is sent, less what it shows) can be above zero in
+  // some channel (not where it shows full white), and below (not where it shows black): a dead
+  // pixel's only ever adds light, a white one's only takes it away.
+  std::vector<std::array<bool, 2>> can_be;
   // (row, column, defect slot, weight): sorted, each pixel's shares lie together.
   std::vector<std::tuple<int, int, std::int32_t, float>> shares;
   for (const auto& correction : plan->corrections) {
@@ -60,19 +65,43 @@ void GlDefectCompensation::prepare(EyeBuffers& eye, const std::shared_ptr<const 
     const auto rgb = d.shown_rgb();
     const auto slot = static_cast<std::int32_t>(defects.size());
     defects.push_back({{d.x, d.y, 0, 0}, {rgb[0] / 255.f, rgb[1] / 255.f, rgb[2] / 255.f, 0.f}});
+    can_be.push_back({std::any_of(rgb.begin(), rgb.end(), [](std::uint8_t v) { return v < 255; }),
+                      std::any_of(rgb.begin(), rgb.end(), [](std::uint8_t v) { return v > 0; })});
     for (const auto& share : correction.shares)
-      if (inside(share.x, share.y)) shares.emplace_back(share.y, share.x, slot, share.weight);
+      if (inside(share.x, share.y) && share.weight != 0.f) shares.emplace_back(share.y, share.x, slot, share.weight);
   }
   std::sort(shares.begin(), shares.end());
-  std::vector<std::array<std::int32_t, 4>> pixels;
+  // Each pixel with its shares, and whether its sum can be positive or negative: only those that
+  // can take the adding draw, only those that can the subtracting one (on llvmpipe each point
+  // costs; most pixels need one of the two).
+  struct Pixel {
+    std::array<std::int32_t, 4> at;  // x, y, first share, shares
+    bool positive = false, negative = false;
+  };
+  std::vector<Pixel> listed;
   std::vector<GpuShare> flat;
   for (std::size_t i = 0; i < shares.size(); ++i) {
     const auto [y, x, slot, weight] = shares[i];
-    if (pixels.empty() || pixels.back()[0] != x || pixels.back()[1] != y)
-      pixels.push_back({x, y, static_cast<std::int32_t>(flat.size()), 0});
-    ++pixels.back()[3];
+    if (listed.empty() || listed.back().at[0] != x || listed.back().at[1] != y)
+      listed.push_back({{x, y, static_cast<std::int32_t>(flat.size()), 0}});
+    Pixel& pixel = listed.back();
+    ++pixel.at[3];
+    const auto [up, down] = can_be[static_cast<std::size_t>(slot)];
+    pixel.positive |= weight > 0.f ? up : down;
+    pixel.negative |= weight > 0.f ? down : up;
     flat.push_back({slot, weight});
   }
+  // Adding only, then both, then subtracting only: the adding draw takes the first two groups,
+  // the subtracting one the last two.
+  std::vector<std::array<std::int32_t, 4>> pixels;
+  for (int group = 0; group < 3; ++group)
+    for (const Pixel& pixel : listed) {
+      const int in = pixel.positive && pixel.negative ? 1 : pixel.positive ? 0 : pixel.negative ? 2 : -1;
+      if (in != group) continue;
+      if (group == 0) ++eye.adding_only;
+      if (group == 2) ++eye.subtracting_only;
+      pixels.push_back(pixel.at);
+    }
   eye.defects = make_storage_buffer(defects);
   eye.pixels = make_storage_buffer(pixels);
   eye.shares = make_storage_buffer(flat);
@@ -126,10 +155,10 @@ void GlDefectCompensation::apply(const EyeDefectPlans& plans,
     glBlendFunc(GL_ONE, GL_ONE);
     glBlendEquation(GL_FUNC_ADD);
     glProgramUniform1f(apply_.id(), 3, 1.f);
-    glDrawArrays(GL_POINTS, 0, eye.pixel_count);
+    glDrawArrays(GL_POINTS, 0, eye.pixel_count - eye.subtracting_only);
     glBlendEquation(GL_FUNC_REVERSE_SUBTRACT);
     glProgramUniform1f(apply_.id(), 3, -1.f);
-    glDrawArrays(GL_POINTS, 0, eye.pixel_count);
+    glDrawArrays(GL_POINTS, eye.adding_only, eye.pixel_count - eye.adding_only);
     glBlendEquation(GL_FUNC_ADD);
     glDisable(GL_BLEND);
     glBindTextureUnit(1, 0);

@@ -35,6 +35,9 @@ class GlDefectCompensation {
     std::shared_ptr<const EyeDefectPlan> made_for;
     gl::Buffer defects, pixels, shares;
     int defect_count = 0, pixel_count = 0;
+    // The pixels are listed adding only, then both, then subtracting only: how many of the first
+    // and the last.
+    int adding_only = 0, subtracting_only = 0;
     std::array<int, 2> slots{0, 0};
     gl::Texture differences;
     gl::Framebuffer differences_fbo;

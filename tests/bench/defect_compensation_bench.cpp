@@ -4,6 +4,9 @@
 // Images. Two plans: the planner's for 1000 defects spread over the lit panel (0.1 % dead, a tenth
 // of those stuck at white), and the same defects with 12 shares each (a retinal point collects
 // about 12 pixels), so the figure does not hang on how many shares the planner keeps.
+// Then the GL passes (compositor/gl/gl_defect_compensation.hpp) on the same frame as a display's
+// BGRA8 texture, on the headless context's device (NELF_GPU, else the first GPU, else llvmpipe),
+// glFinish included.
 // usage: nelf_defect_compensation_bench [RUNS]
 #include <algorithm>
 #include <cstdio>
@@ -13,6 +16,8 @@
 #include <vector>
 
 #include "bench/bench_timing.hpp"
+#include "compositor/gl/gl_defect_compensation.hpp"
+#include "core/gl/egl_context.hpp"
 #include "optics/defect_compensation.hpp"
 #include "optics/defect_map.hpp"
 #include "optics/mapping.hpp"
@@ -81,6 +86,28 @@ int main(int argc, char** argv) {
     std::printf("%s (%zu shares): median per frame %.3f ms (8-bit), %.3f ms (16-bit), %.3f ms (float)\n",
                 plan == &planned ? "planner's plan" : "12 shares a defect", shares, nelf::bench::median(bytes8),
                 nelf::bench::median(bytes16), nelf::bench::median(floats));
+  }
+
+  const auto context = std::make_shared<nelf::gl::EglContext>(nelf::gl::ContextOptions{});
+  const nelf::gl::Texture texture = nelf::gl::make_bgra8_texture_2d(frame_w, frame_h);
+  const nelf::gl::Framebuffer fbo = nelf::gl::make_framebuffer(texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(texture.id(), 0, 0, 0, frame_w, frame_h, GL_RGBA, GL_UNSIGNED_BYTE, rgba8.data());
+  const nelf::GlPackedTarget target{fbo.id(), texture.id(), {frame_w, frame_h}};
+  const std::array<std::optional<std::pair<int, int>>, 2> origins{std::pair{0, 0}, std::nullopt};
+  nelf::GlDefectCompensation compensation;
+  for (const nelf::EyeDefectPlan* plan : {&std::as_const(planned), &twelve}) {
+    const nelf::EyeDefectPlans plans{std::make_shared<const nelf::EyeDefectPlan>(*plan), nullptr};
+    compensation.apply(plans, origins, target);  // the buffers, once per plan
+    glFinish();
+    std::vector<double> times;
+    for (int i = 0; i < runs; ++i)
+      times.push_back(nelf::bench::elapsed_ms([&] {
+        compensation.apply(plans, origins, target);
+        glFinish();
+      }));
+    std::printf("GL (%s), %s: median per frame %.3f ms\n", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
+                plan == &planned ? "planner's plan" : "12 shares a defect", nelf::bench::median(times));
   }
   return 0;
 }
