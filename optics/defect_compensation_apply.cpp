@@ -21,15 +21,22 @@ using Rgb = std::array<float, 3>;
 
 // The corrections a frame adds, summed per pixel: a pixel several defects share with takes their
 // shares together and is clipped once, whatever the order of the defects. An open-addressing table
-// keyed by the pixel's index, sized for the plan's shares (a few thousand: far cheaper per frame
-// than touching a panel-sized buffer).
+// keyed by where the pixel is, sized for the plan's shares (a few thousand: far cheaper per frame
+// than touching a panel-sized buffer), and kept per thread from frame to frame: only the slots a
+// frame used are emptied for the next.
 class ShareSums {
  public:
-  explicit ShareSums(std::size_t shares) {
+  // Empty, with room for `shares`.
+  void reset(std::size_t shares) {
     const std::size_t slots = std::bit_ceil(std::max<std::size_t>(16, shares * 2));
-    mask_ = slots - 1;
-    keys_.assign(slots, empty_key);
-    sums_.resize(slots);
+    if (slots != keys_.size()) {
+      mask_ = slots - 1;
+      keys_.assign(slots, empty_key);
+      sums_.resize(slots);
+    } else {
+      for (std::size_t slot : touched_) keys_[slot] = empty_key;
+    }
+    touched_.clear();
     touched_.reserve(shares);
   }
 
@@ -72,10 +79,11 @@ Rgb shown(const PixelDefect& defect) {
 // The shares of every correction, from `read(x, y)` (0..1 per channel, the image as given),
 // summed per `key(x, y)` (where the pixel is: an index, or a byte offset).
 template <class Read, class Key>
-ShareSums sum_shares(const EyeDefectPlan& plan, Read&& read, Key&& key) {
+const ShareSums& sum_shares(const EyeDefectPlan& plan, Read&& read, Key&& key) {
   std::size_t shares = 0;
   for (const auto& correction : plan.corrections) shares += correction.shares.size();
-  ShareSums sums(shares);
+  thread_local ShareSums sums;
+  sums.reset(shares);
   for (const auto& correction : plan.corrections) {
     const PixelDefect& defect = correction.defect;
     if (correction.shares.empty() || !inside(plan.panel, defect.x, defect.y)) continue;
@@ -100,7 +108,7 @@ void compensate_channels(const EyeDefectPlan& plan, std::uint8_t* rgba, std::siz
     std::memcpy(channels, rgba + offset(x, y), sizeof(channels));
     return Rgb{channels[0] / full, channels[1] / full, channels[2] / full};
   };
-  const ShareSums sums = sum_shares(plan, read, offset);
+  const ShareSums& sums = sum_shares(plan, read, offset);
   sums.for_each([&](std::size_t at, const Rgb& sum) {
     Channel channels[3];
     std::memcpy(channels, rgba + at, sizeof(channels));
@@ -121,7 +129,7 @@ void compensate_defects(const EyeDefectPlan& plan, Image& eye) {
   const auto index = [&](int x, int y) {
     return static_cast<std::size_t>(y) * static_cast<std::size_t>(eye.width()) + static_cast<std::size_t>(x);
   };
-  const ShareSums sums = sum_shares(
+  const ShareSums& sums = sum_shares(
       plan,
       [&](int x, int y) {
         const Rgba& p = eye.at(x, y);
