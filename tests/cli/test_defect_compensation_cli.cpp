@@ -100,5 +100,20 @@ TEST(DefectCompensationCli, ConvertHidesTheDefectsOnlyAtTheirBundles) {
   }
 }
 
+TEST(DefectCompensationCli, CalibratesPatternImageIsHiddenToo) {
+  TempDir dir;
+  test::write_file(dir / "panel.defects",
+                   "left 80 45 dead\nleft 70 40 stuck 255 255 255\nleft 90 50 stuck 255 0 0\n"
+                   "right 81 44 dead\nright 60 50 stuck 255 255 255\n");
+  test::write_file(dir / "mapped.toml", small_profile_text(true));
+  const std::string base = "calibrate --pattern grid --signal sbs --profile " + q(dir / "mapped.toml") + " --output ";
+  const auto on = run_nelf(base + q(dir / "on.png"));
+  ASSERT_EQ(on.status, 0) << on.err;
+  EXPECT_NE(on.err.find("nelf: hiding "), std::string::npos) << on.err;
+  const auto off = run_nelf(base + q(dir / "off.png") + " --no-defect-compensation");
+  ASSERT_EQ(off.status, 0) << off.err;
+  EXPECT_FALSE(differing(read_back(dir / "on.png"), read_back(dir / "off.png")).empty());
+}
+
 }  // namespace
 }  // namespace nelf
