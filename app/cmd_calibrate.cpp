@@ -35,6 +35,7 @@ struct CalibrateArgs {
   int fsaa = 1;
   std::optional<int> gpu;
   bool overwrite = false;
+  bool no_defect_compensation = false;
 };
 
 bool is_live_output(const std::string& name) { return find_display_driver(name) != nullptr; }
@@ -55,6 +56,7 @@ CompositorOptions compositor_options(const CalibrateArgs& args) {
   CompositorOptions options;
   options.fsaa = args.fsaa;
   options.gpu = args.gpu;
+  options.defect_compensation = !args.no_defect_compensation;
   return options;
 }
 
@@ -150,6 +152,7 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--gpu", args->gpu,
                   "EGL device index (image output only; a live output renders on its display's GPU)");
   cmd->add_flag("-y,--overwrite", args->overwrite, "Replace the image --output if it exists");
+  add_defect_compensation_option(*cmd, args->no_defect_compensation);
   cmd->callback([args] { run_calibrate(*args); });
 }
 

@@ -249,6 +249,7 @@ CommonOptions parse_common_options(const CommonArgs& args, bool still) {
   }
   common.compositor.fsaa = args.fsaa;
   common.compositor.gpu = args.gpu;
+  common.compositor.defect_compensation = !args.no_defect_compensation;
 
   common.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
   common.signal = resolve_signal(common.profile, args.signal);
@@ -281,7 +282,14 @@ void add_common_options(CLI::App& cmd, CommonArgs& args) {
                  "EGL device index to render on (default: NELF_GPU, else the first GPU, else software)");
   cmd.add_flag("--allow-network", args.allow_network,
                "Let FFmpeg use network protocols (default: files and pipes only)");
+  add_defect_compensation_option(cmd, args.no_defect_compensation);
   add_max_pixels_option(cmd, args.max_pixels);
+}
+
+void add_defect_compensation_option(CLI::App& cmd, bool& no_defect_compensation) {
+  cmd.add_flag("--no-defect-compensation", no_defect_compensation,
+               "Show the dead and stuck pixels of the profile's defect map as they are (default: hidden by "
+               "their ray bundles)");
 }
 
 void add_max_pixels_option(CLI::App& cmd, std::int64_t& max_pixels) {

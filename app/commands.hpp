@@ -35,6 +35,7 @@ struct CommonArgs {
   std::optional<int> gpu;
   bool allow_network = false;
   std::int64_t max_pixels = kDefaultMaxPixels;
+  bool no_defect_compensation = false;
 };
 
 // CommonArgs checked before any input is read: layout, antialiasing, device, profile and signal.
@@ -47,6 +48,8 @@ struct CommonOptions {
 
 // Registers INPUT (positional) and the CommonArgs options on `cmd`.
 void add_common_options(CLI::App& cmd, CommonArgs& args);
+// Registers --no-defect-compensation (shared by convert, play and calibrate: one wording).
+void add_defect_compensation_option(CLI::App& cmd, bool& no_defect_compensation);
 // Registers --max-pixels (shared by convert, play, probe and simulate: one wording).
 void add_max_pixels_option(CLI::App& cmd, std::int64_t& max_pixels);
 // Throws UserError (status 2) for contradictory options and unknown signals, ProfileError for bad

@@ -29,6 +29,10 @@ struct CompositorOptions {
   // device, else Mesa's software renderer.
   std::optional<int> gpu;
   DepthMode depth = DepthMode::off;
+  // Hide the dead and stuck pixels of the profile's defect map (correction.defect_map) with the
+  // other pixels of their ray bundles (optics/defect_compensation.hpp); `--no-defect-compensation`
+  // shows them as they are, to compare. Without a map there is nothing to do either way.
+  bool defect_compensation = true;
 };
 
 // Throws std::invalid_argument naming the allowed values when `fsaa` is not 0, 1, 4 or 16.

@@ -6,9 +6,13 @@
 #include <utility>
 
 #include "compositor/gl/gl_compositor.hpp"
+#include "compositor/gl/gl_defect_compensation.hpp"
 #include "compositor/overlays/calibration_overlay.hpp"
 #include "compositor/overlays/text_overlay.hpp"
 #include "core/gl/egl_context.hpp"
+#include "optics/defect_compensation.hpp"
+#include "optics/defect_map.hpp"
+#include "optics/mapping.hpp"
 
 namespace nelf {
 
@@ -203,22 +207,24 @@ std::shared_ptr<const CompositeSetup> FrameCompositor::ahead_setup(const FrameOv
   if (!table_path_open() || !tables_tried_ || !(tables_[0] || tables_[1])) return nullptr;
   std::shared_ptr<const std::array<Image, 2>> grid;
   std::shared_ptr<const Image> message;
+  EyeDefectPlans defects;
   try {
     if (overlays.calibration_grid) {
       calibration_grid(0);  // as prepare() would make it for the next frame (the optics may have changed)
       grid = grid_;
     }
     message = message_cover(overlays.message);
+    defects = defect_plans({content_aspect(), content_aspect()}, true);
   } catch (const std::runtime_error&) {
-    return nullptr;  // no grid for these optics, or no font: render() says so
+    return nullptr;  // no grid for these optics, or no font, or no mapping: render() says so
   }
   if (!setup_ || setup_->swap_eyes != overlays.swap_eyes || setup_->grid != grid || setup_->message != message ||
-      setup_->packed != packed) {
+      setup_->packed != packed || setup_->defects != defects) {
     // The worker's own copy (once per tables): a table's render() uses its scratch buffers.
     if (!worker_tables_) worker_tables_ = std::make_shared<std::array<std::optional<CompositeTable>, 2>>(tables_);
     setup_ = std::make_shared<const CompositeSetup>(
         CompositeSetup{worker_tables_, layout_.origins, packed, overlays.swap_eyes, grid, views_.width, views_.height,
-                       views_.block, views_.aspect, message});
+                       views_.block, views_.aspect, message, defects});
   }
   return setup_;
 }
@@ -270,7 +276,15 @@ bool FrameCompositor::render(const Frame& frame, const FrameOverlays& overlays, 
     start_gl();
     const float black[4] = {0.f, 0.f, 0.f, 1.f};
     glClearNamedFramebufferfv(gl_target->framebuffer, GL_COLOR, 0, black);
-    if (shown) render_gl(overlays, gl_target->framebuffer);
+    if (shown) {
+      render_gl(overlays, gl_target->framebuffer);
+      // The corrections on the GPU, from the frame as drawn: no read-back.
+      const EyeDefectPlans& plans = defect_plans({content_aspect(), content_aspect()}, false);
+      if (plans[0] || plans[1]) {
+        if (!defect_gl_) defect_gl_ = std::make_unique<GlDefectCompensation>();
+        defect_gl_->apply(plans, layout_.origins, *gl_target);
+      }
+    }
     return false;
   }
   PackedFrame& out = *std::get<PackedFrame*>(target.where);
@@ -298,6 +312,10 @@ bool FrameCompositor::render(const Frame& frame, const FrameOverlays& overlays, 
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadPixels(0, 0, out.width, out.height, GL_RGBA, bits > 8 ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE, out.rgba.data());
   gl::check_error("reading back the packed frame");
+  // The frame is read back whole anyway: its corrections on the CPU.
+  if (shown)
+    compensate_packed_eyes(defect_plans({content_aspect(), content_aspect()}, false), layout_.origins, out.rgba.data(),
+                           static_cast<std::size_t>(out.width) * bytes_per_pixel(bits), bits);
   return false;
 }
 
@@ -307,6 +325,8 @@ void FrameCompositor::render_tables(const FrameOverlays& overlays, const GlPacke
   const auto views = covered_views(overlays.message);
   render_packed_frame(tables_, views, static_cast<std::size_t>(texture_w()) * 4, overlays.swap_eyes, layout_.origins,
                       target.size, packed_);
+  compensate_packed_eyes(defect_plans({content_aspect(), content_aspect()}, true), layout_.origins,
+                         packed_.pixels.data(), static_cast<std::size_t>(target.size[0]) * 4, 8);
   upload_packed(target, packed_.pixels.data());
 }
 
@@ -321,6 +341,8 @@ void FrameCompositor::render_tables(const FrameOverlays& overlays, PackedFrame& 
   // render in parallel.
   render_packed_eyes(tables_, views, static_cast<std::size_t>(texture_w()) * 4, layout_.origins, out.rgba.data(),
                      static_cast<std::size_t>(out.width) * 4);
+  compensate_packed_eyes(defect_plans({content_aspect(), content_aspect()}, false), layout_.origins, out.rgba.data(),
+                         static_cast<std::size_t>(out.width) * 4, 8);
 }
 
 // Opaque black wherever the eyes do not draw (the gap, and borders when a panel is smaller than its
@@ -440,7 +462,53 @@ Image FrameCompositor::render_still(const StereoPair& views) {
     depth_notice(
         "a still carries no depth (estimating it from the two views is not built in); showing the flat screen");
   start_gl();
-  return place_eyes(layout_, compositor_->compose(views));
+  EyeImages eyes = compositor_->compose(views);
+  const EyeDefectPlans& plans = defect_plans({views.left.aspect(), views.right.aspect()}, false);
+  for (std::size_t e = 0; e < 2; ++e)
+    if (plans[e]) compensate_defects(*plans[e], eyes[e]);
+  return place_eyes(layout_, eyes);
+}
+
+double FrameCompositor::content_aspect() const {
+  return views_.aspect > 0.0 ? views_.aspect : static_cast<double>(views_.width) / views_.height;
+}
+
+// The plans for the current profile and `aspects` (per eye), made when either changes: planning
+// solves a small problem per defect, once per profile, not per frame. `bgra`: the plans for BGRA
+// bytes (what the tables' packed frames are), whose stuck colours are in that order.
+const EyeDefectPlans& FrameCompositor::defect_plans(std::array<double, 2> aspects, bool bgra) {
+  if (defect_plans_.generation != profile_generation_ || defect_plans_.aspects != aspects) {
+    DefectPlans made;
+    made.generation = profile_generation_;
+    made.aspects = aspects;
+    const auto& map = profile_.correction.defects;
+    if (options_.defect_compensation && map && !map->empty()) {
+      int hidden = 0, outside = 0, uncompensable = 0;
+      for (Eye eye : {Eye::left, Eye::right}) {
+        const auto e = static_cast<std::size_t>(eye);
+        if (!layout_.origins[e]) continue;  // the signal does not carry this eye
+        EyeDefectPlan plan = plan_defect_compensation(make_eye_mapping(profile_, eye, aspects[e]), *map);
+        for (const auto& correction : plan.corrections) hidden += correction.shares.empty() ? 0 : 1;
+        outside += plan.outside_lit;
+        uncompensable += plan.uncompensable;
+        if (plan.empty()) continue;
+        EyeDefectPlan swapped = plan;
+        for (auto& correction : swapped.corrections)
+          std::swap(correction.defect.stuck_rgb[0], correction.defect.stuck_rgb[2]);
+        made.rgba[e] = std::make_shared<const EyeDefectPlan>(std::move(plan));
+        made.bgra[e] = std::make_shared<const EyeDefectPlan>(std::move(swapped));
+      }
+      if (!defect_notice_given_) {
+        defect_notice_given_ = true;
+        fmt::print(stderr,
+                   "nelf: hiding {} defects of the profile's defect map ({} outside the lit area need nothing, {} "
+                   "could not be)\n",
+                   hidden, outside, uncompensable);
+      }
+    }
+    defect_plans_ = std::move(made);
+  }
+  return bgra ? defect_plans_.bgra : defect_plans_.rgba;
 }
 
 }  // namespace nelf

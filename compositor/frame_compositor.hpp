@@ -30,6 +30,7 @@
 namespace nelf {
 
 class GlCompositor;
+class GlDefectCompensation;
 class TextOverlay;
 
 // What is drawn over or done to a frame besides compositing it. The message and the grid go into
@@ -128,6 +129,13 @@ class FrameCompositor {
   // its ray meets the content's surface.
   bool depth_aware() const { return depth_frame_; }
 
+  // The defect compensation eye `eye` takes for frames of the current views (or, after a still,
+  // the still's), or null when there is nothing to hide: no defect map, none on that eye, or
+  // options().defect_compensation off. Made when first needed.
+  std::shared_ptr<const EyeDefectPlan> defect_plan(Eye eye) const {
+    return defect_plans_.rgba[static_cast<std::size_t>(eye)];
+  }
+
   // A still: float views composited by GL (no composite tables: they replay 8-bit block means,
   // and stills keep 16-bit and float precision) and placed by the layout, cropped to the eye areas
   // as pack_eyes does. The views' own size and aspect; frames are not involved.
@@ -158,6 +166,8 @@ class FrameCompositor {
   void upload_packed(const GlPackedTarget& target, const std::uint8_t* bgra);
   void update_depth(const StereoVideoFrame& frame);
   void depth_notice(const std::string& why);
+  double content_aspect() const;
+  const EyeDefectPlans& defect_plans(std::array<double, 2> aspects, bool bgra);
 
   Profile profile_;
   CompositorOptions options_;
@@ -206,6 +216,18 @@ class FrameCompositor {
   std::array<std::shared_ptr<const DisparitySurface>, 2> surfaces_;
   bool depth_frame_ = false;
   bool depth_notice_given_ = false;
+  // The dead and stuck pixels of the profile's defect map hidden after compositing: per eye, the
+  // plan for RGBA bytes (and floats, and GL) and the same for BGRA bytes (the tables' packed frames),
+  // made for the profile generation and the content aspect per eye they were made for; the one
+  // line said when they are first made.
+  struct DefectPlans {
+    int generation = -1;
+    std::array<double, 2> aspects{0.0, 0.0};
+    EyeDefectPlans rgba, bgra;
+  };
+  DefectPlans defect_plans_;
+  bool defect_notice_given_ = false;
+  std::unique_ptr<GlDefectCompensation> defect_gl_;  // with GL, when a GL target takes a plan
   std::shared_ptr<std::array<std::optional<CompositeTable>, 2>> worker_tables_;
   std::shared_ptr<const CompositeSetup> setup_;
   CompositeAhead ahead_{ahead_depth};

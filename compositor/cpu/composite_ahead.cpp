@@ -162,7 +162,21 @@ bool CompositeAhead::composite(const CompositeSetup& setup, const StereoVideoFra
                             setup.message.get(), views_[i]);
   render_packed_frame(*setup.tables, views, static_cast<std::size_t>(texture_w) * 4, setup.swap_eyes, setup.origins,
                       setup.packed, out);
+  compensate_packed_eyes(setup.defects, setup.origins, out.pixels.data(), static_cast<std::size_t>(setup.packed[0]) * 4,
+                         8);
   return true;
+}
+
+void compensate_packed_eyes(const EyeDefectPlans& plans,
+                            const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::uint8_t* packed,
+                            std::size_t stride, int bits) {
+  for (std::size_t e = 0; e < 2; ++e) {
+    if (!plans[e] || !origins[e]) continue;
+    const auto [x, y] = *origins[e];
+    compensate_defects(
+        *plans[e], packed + static_cast<std::size_t>(y) * stride + static_cast<std::size_t>(x) * bytes_per_pixel(bits),
+        bits, stride);
+  }
 }
 
 const std::uint8_t* covered_view(std::span<const std::uint8_t> view, const Image* grid, const Image* message,

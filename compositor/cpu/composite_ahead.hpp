@@ -27,14 +27,25 @@
 #include <vector>
 
 #include "compositor/cpu/composite_table.hpp"
-#include "core/image.hpp"
 #include "core/frames.hpp"
+#include "core/image.hpp"
+#include "optics/defect_compensation.hpp"
 
 namespace nelf {
 
 // Everything a packed frame made from the tables depends on besides the frame itself. Shared
 // read-only between the display's thread, which makes it, and the worker, except `tables`: their
 // render() uses scratch buffers, so they are the worker's own copy, rendered only by the worker.
+// Per eye, the defect compensation a packed frame's panel takes (optics/defect_compensation.hpp),
+// made for the frame's channel order; null: nothing to hide on that eye.
+using EyeDefectPlans = std::array<std::shared_ptr<const EyeDefectPlan>, 2>;
+
+// Each eye's plan applied to its panel in `packed` (`bits` a channel, `stride` bytes a row), the
+// panel's top-left corner at origins[e].
+void compensate_packed_eyes(const EyeDefectPlans& plans,
+                            const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::uint8_t* packed,
+                            std::size_t stride, int bits);
+
 struct CompositeSetup {
   std::shared_ptr<std::array<std::optional<CompositeTable>, 2>> tables;  // per eye
   std::array<std::optional<std::pair<int, int>>, 2> origins;             // panels' top-left corners
@@ -47,6 +58,8 @@ struct CompositeSetup {
   double aspect = 0.0;
   // The on-screen message over both views, after the grid (TextOverlay::cover), or none.
   std::shared_ptr<const Image> message;
+  // The dead and stuck pixels hidden after compositing, per eye (plans for BGRA bytes), or none.
+  EyeDefectPlans defects;
 };
 
 // The bytes a view is composited from: `view` itself, or, with a calibration `grid` or a `message`

@@ -31,6 +31,10 @@ std::string_view kind_name(ProgramKind kind) {
       return "depth";
     case ProgramKind::depth_border:
       return "depth_border";
+    case ProgramKind::defect_gather:
+      return "defect_gather";
+    case ProgramKind::defect_apply:
+      return "defect_apply";
   }
   return "unknown";
 }
@@ -68,6 +72,10 @@ ProgramSource program_source(ProgramKind kind, int subsamples) {
       return {"fullscreen.vert", "elemental.frag", per_axis + "#define NELF_DEPTH 1\n"};
     case ProgramKind::depth_border:
       return {"border_strips.vert", "elemental.frag", per_axis + "#define NELF_AREA_SAMPLE 1\n#define NELF_DEPTH 1\n"};
+    case ProgramKind::defect_gather:
+      return {"defect_gather.vert", "defect_gather.frag", {}};
+    case ProgramKind::defect_apply:
+      return {"defect_apply.vert", "defect_apply.frag", {}};
   }
   throw std::invalid_argument("program_source: unknown program kind");
 }

@@ -38,7 +38,7 @@ std::shared_ptr<const CompositeSetup> make_setup(bool swap_eyes,
   (*tables)[0] = identity_table();
   (*tables)[1] = identity_table();
   return std::make_shared<const CompositeSetup>(CompositeSetup{
-      tables, {std::pair{0, 0}, std::pair{2, 0}}, {3, 1}, swap_eyes, std::move(grid), 1, 1, {1, 1}, 0.0, nullptr});
+      tables, {std::pair{0, 0}, std::pair{2, 0}}, {3, 1}, swap_eyes, std::move(grid), 1, 1, {1, 1}, 0.0, nullptr, {}});
 }
 
 using Pixel = std::array<int, 4>;
