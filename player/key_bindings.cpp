@@ -159,7 +159,7 @@ const std::vector<KeyBinding>& key_bindings() {
        "space 1-5",
        "`space`, `1`-`5`",
        "field colour: next / black, white, red, green, blue",
-       "(stuck pixels stand out on black, dead ones on white)",
+       "(Shift+space back; stuck pixels stand out on black, dead ones on white)",
        ""},
       {S::defects,
        {{ch(U'd'), C::mark_dead}, {ch(U'D'), C::mark_dead}},
