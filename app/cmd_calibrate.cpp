@@ -163,6 +163,19 @@ void check_save_path(const std::string& path) {
     throw UserError(fmt::format("--save {}: a profile is a .toml file (e.g. my-hmz.toml)", path), 2);
 }
 
+// A map beside --save that the profile does not name is someone's earlier work (or another
+// file): --defects would replace it with the marks of this session, so it is refused before
+// anything is shown.
+void check_defect_map_target(const Profile& profile, const std::string& save) {
+  const DefectMapSave where = defect_map_save(profile, save);
+  std::error_code ec;
+  if (profile.correction.defect_map_path.empty() && !where.map.empty() && std::filesystem::exists(where.map, ec))
+    throw UserError(fmt::format("--save {}: {} exists and the profile names no defect map; to continue it, set "
+                                "correction.defect_map = \"{}\" in the profile, else move it away",
+                                save, where.map.string(), where.map.filename().string()),
+                    2);
+}
+
 void run_calibrate(const CalibrateArgs& args) {
   const std::optional<DefectField> defects = defect_mode(args);
   if (!is_live_output(args.output))
@@ -177,6 +190,7 @@ void run_calibrate(const CalibrateArgs& args) {
   session.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
   session.signal = resolve_signal(session.profile, args.signal);
   check_save_path(args.save);
+  if (defects) check_defect_map_target(session.profile, args.save);
   session.save = args.save;
   session.monitor = args.monitor;
   session.connector = args.connector;

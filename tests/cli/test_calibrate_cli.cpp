@@ -189,6 +189,20 @@ TEST(CalibrateCli, BadArgumentsSayWhatAndWriteNothing) {
   }
 }
 
+TEST(CalibrateCli, DefectsKeepsAMapTheProfileDoesNotName) {
+  // mine.defects beside --save mine.toml, not named by the profile: refused before any window
+  // opens, the file left as it was.
+  TempDir dir;
+  test::write_file(dir / "mine.defects", "left 1 1 dead\n");
+  const auto r = run_nelf("calibrate --defects --output offscreen --save " + shell_quote((dir / "mine.toml").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err, "nelf: --save " + (dir / "mine.toml").string() + ": " + (dir / "mine.defects").string() +
+                       " exists and the profile names no defect map; to continue it, set correction.defect_map = "
+                       "\"mine.defects\" in the profile, else move it away\n");
+  EXPECT_EQ(test::read_file(dir / "mine.defects"), "left 1 1 dead\n");
+  EXPECT_EQ(files_in(dir.path()), std::vector<std::string>{"mine.defects"});
+}
+
 TEST(CalibrateCli, UnwritableOutputLeavesNoFile) {
   // /proc takes no new files, not even from root: the write itself fails after the checks pass.
   const auto r = run_nelf("calibrate --pattern grid --output /proc/nelf-calibrate-test.png");
