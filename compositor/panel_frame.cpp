@@ -4,7 +4,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <vector>
@@ -15,18 +14,38 @@ namespace nelf {
 
 namespace {
 
-std::uint8_t to_byte(float v) { return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.f, 1.f) * 255.f)); }
+// As lround(clamp(v) * 255) (v is never negative after the clamp), without the library call: ~7.5
+// million of them a frame.
+std::uint8_t to_byte(float v) { return static_cast<std::uint8_t>(std::clamp(v, 0.f, 1.f) * 255.f + 0.5f); }
 
-// The placed frame as 8-bit bytes, in RGBA or (for a GL texture's upload, a copy there) BGRA order.
-std::vector<std::uint8_t> packed_bytes(const Image& packed, bool bgra) {
-  std::vector<std::uint8_t> bytes(packed.pixels().size() * 4);
-  std::size_t i = 0;
-  for (const Rgba& p : packed.pixels()) {
-    bytes[i + 0] = to_byte(bgra ? p.b : p.r);
-    bytes[i + 1] = to_byte(p.g);
-    bytes[i + 2] = to_byte(bgra ? p.r : p.b);
-    bytes[i + 3] = to_byte(p.a);
-    i += 4;
+// The packed frame as 8-bit bytes, RGBA or (for a GL texture's upload, a copy there) BGRA: the eyes
+// placed and clipped as place_eyes places them, opaque black elsewhere. Written straight from the
+// panels rather than through place_eyes' float frame (four times the bytes) on every key.
+std::vector<std::uint8_t> packed_bytes(const PackedLayout& layout, const EyeImages& panels, bool bgra) {
+  for (const Image& eye : panels)
+    if (eye.width() != layout.eye[0] || eye.height() != layout.eye[1])
+      throw std::invalid_argument(fmt::format("a {}x{} panel image for a layout of {}x{} panels", eye.width(),
+                                              eye.height(), layout.eye[0], layout.eye[1]));
+  const std::size_t width = static_cast<std::size_t>(layout.packed[0]);
+  std::vector<std::uint8_t> bytes(width * static_cast<std::size_t>(layout.packed[1]) * 4, 0);
+  for (std::size_t i = 3; i < bytes.size(); i += 4) bytes[i] = 255;
+  for (std::size_t e = 0; e < 2; ++e) {
+    if (!layout.areas[e]) continue;
+    const EyeArea& area = *layout.areas[e];
+    const Image& eye = panels[e];
+    const int dx = layout.origins[e]->first - area.x, dy = layout.origins[e]->second - area.y;
+    const int x_begin = std::max(0, dx), x_end = std::min(area.width, dx + eye.width());
+    const int y_begin = std::max(0, dy), y_end = std::min(area.height, dy + eye.height());
+    for (int y = y_begin; y < y_end; ++y) {
+      const Rgba* src = &eye.at(x_begin - dx, y - dy);
+      std::uint8_t* out = &bytes[(static_cast<std::size_t>(area.y + y) * width + area.x + x_begin) * 4];
+      for (int x = x_begin; x < x_end; ++x, ++src, out += 4) {
+        out[0] = to_byte(bgra ? src->b : src->r);
+        out[1] = to_byte(src->g);
+        out[2] = to_byte(bgra ? src->r : src->b);
+        out[3] = to_byte(src->a);
+      }
+    }
   }
   return bytes;
 }
@@ -34,12 +53,11 @@ std::vector<std::uint8_t> packed_bytes(const Image& packed, bool bgra) {
 }  // namespace
 
 void render_panel_frame(const PackedLayout& layout, const EyeImages& panels, const PackedTarget& target) {
-  const Image packed = place_eyes(layout, panels);  // std::invalid_argument for a panel of another size
   if (const auto* gl_target = std::get_if<GlPackedTarget>(&target.where)) {
     if (gl_target->size != layout.packed)
       throw std::invalid_argument(fmt::format("a {}x{} packed target for a layout of {}x{}", gl_target->size[0],
                                               gl_target->size[1], layout.packed[0], layout.packed[1]));
-    const std::vector<std::uint8_t> bgra = packed_bytes(packed, true);
+    const std::vector<std::uint8_t> bgra = packed_bytes(layout, panels, true);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTextureSubImage2D(gl_target->texture, 0, 0, 0, gl_target->size[0], gl_target->size[1], GL_BGRA, GL_UNSIGNED_BYTE,
                         bgra.data());
@@ -47,11 +65,11 @@ void render_panel_frame(const PackedLayout& layout, const EyeImages& panels, con
     return;
   }
   PackedFrame& out = *std::get<PackedFrame*>(target.where);
+  out.rgba = packed_bytes(layout, panels, false);
   out.width = layout.packed[0];
   out.height = layout.packed[1];
   out.bits = 8;
   out.pts_seconds = 0.0;
-  out.rgba = packed_bytes(packed, false);
 }
 
 }  // namespace nelf
