@@ -202,7 +202,9 @@ void run_calibrate(const CalibrateArgs& args) {
 void add_calibrate_command(CLI::App& app) {
   auto args = std::make_shared<CalibrateArgs>();
   auto* cmd = app.add_subcommand(
-      "calibrate", "Tune a profile to your eyes with test patterns and keys (h for help), or write a pattern image");
+      "calibrate",
+      "Tune a profile to your eyes with test patterns and keys (h for help), or write a pattern image; "
+      "--defects marks dead and stuck pixels");
   cmd->add_option("--profile", args->profile, "Device profile to start from: built-in name or TOML file")
       ->capture_default_str();
   cmd->add_option("--output", args->output,
