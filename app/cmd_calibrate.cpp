@@ -1,7 +1,9 @@
 // `nelf calibrate`: test patterns drawn through the compositor, with keys that tune the profile's
 // calibration live (player/calibration_controls) and --save to keep the result; or, with
 // --pattern and an image file as --output, the packed pattern frame written headless like a still
-// converted by `nelf convert`.
+// converted by `nelf convert`. With --defects: flat fields on the panels without the lens mapping,
+// keys that mark dead and stuck pixels, and the defect map saved beside the profile; or, with an
+// image file as --output, the packed flat field written headless.
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -15,10 +17,12 @@
 #include "hmz_output/display.hpp"
 #include "hmz_output/display_drivers.hpp"
 #include "hmz_output/image_sink.hpp"
+#include "hmz_output/packing.hpp"
 #include "inputs/test_patterns.hpp"
 #include "optics/profile.hpp"
 #include "player/calibrate_session.hpp"
 #include "player/calibration_controls.hpp"
+#include "player/defect_marking.hpp"
 #include "player/input_files.hpp"
 
 namespace nelf::app {
@@ -36,6 +40,9 @@ struct CalibrateArgs {
   std::optional<int> gpu;
   bool overwrite = false;
   bool no_defect_compensation = false;
+  bool defects = false;
+  std::string field;
+  bool fsaa_given = false;  // --fsaa on the command line (it has a default)
 };
 
 bool is_live_output(const std::string& name) { return find_display_driver(name) != nullptr; }
@@ -96,6 +103,55 @@ void write_pattern_image(const CalibrateArgs& args) {
   write_packed_still(pattern_views(pattern, profile), profile, signal, options, args.output, write);
 }
 
+// --defects: which options go with it. The flat field is the panel's own pixels, so the options
+// of the lens mapping's patterns do not apply; --field names the first field and means nothing
+// without --defects.
+std::optional<DefectField> defect_mode(const CalibrateArgs& args) {
+  if (!args.defects) {
+    if (!args.field.empty())
+      throw UserError(fmt::format("--field {} is the flat field of --defects: add --defects", args.field), 2);
+    return std::nullopt;
+  }
+  if (!args.pattern.empty())
+    throw UserError(fmt::format("--defects shows flat fields, not --pattern {}: leave one out", args.pattern), 2);
+  if (args.fsaa_given)
+    throw UserError("--fsaa antialiases the lens mapping, which --defects does not use: leave it out", 2);
+  if (args.field.empty()) return DefectField::black;
+  const auto field = parse_defect_field(args.field);
+  if (!field)
+    throw UserError(fmt::format("unknown field '{}' (use {})", args.field, fmt::join(defect_field_names(), ", ")), 2);
+  return field;
+}
+
+// Headless --defects: the packed frame of the flat field, the profile's known defects ringed as
+// the live panels show them (no cursor, no status line).
+void write_defect_field_image(const CalibrateArgs& args, DefectField field) {
+  if (!args.save.empty())
+    throw UserError(fmt::format("--save keeps what the keys marked and needs a window (--output {}), not an image file",
+                                display_driver_names()),
+                    2);
+  InputFiles inputs;
+  inputs.add(args.profile, "the --profile");
+  inputs.refuse_as_output(args.output);
+  const Profile profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
+  const Signal signal = resolve_signal(profile, args.signal);
+  ImageWriteOptions write;
+  write.overwrite = args.overwrite;
+  try {
+    check_image_writable(args.output, write);
+  } catch (const ImageWriteError& e) {
+    throw UserError(e.what(), 1);
+  }
+  const DefectMap known = profile.correction.defects ? *profile.correction.defects : DefectMap{};
+  const EyeImages panels = {DefectMarking::field_image(profile.display.resolution, field, known, Eye::left),
+                            DefectMarking::field_image(profile.display.resolution, field, known, Eye::right)};
+  try {
+    write_image_file(place_eyes(packed_layout(signal, profile.display.resolution), panels), args.output, write);
+  } catch (const ImageWriteError& e) {
+    throw UserError(e.what(), 1);
+  }
+}
+
 // --save must be writable before the user spends time calibrating.
 void check_save_path(const std::string& path) {
   if (path.empty()) return;
@@ -109,17 +165,34 @@ void check_save_path(const std::string& path) {
     throw UserError(fmt::format("--save {}: a profile is a .toml file (e.g. my-hmz.toml)", path), 2);
 }
 
+// A map beside --save that the profile does not name is someone's earlier work (or another
+// file): --defects would replace it with the marks of this session, so it is refused before
+// anything is shown.
+void check_defect_map_target(const Profile& profile, const std::string& save) {
+  const DefectMapSave where = defect_map_save(profile, save);
+  std::error_code ec;
+  if (profile.correction.defect_map_path.empty() && !where.map.empty() && std::filesystem::exists(where.map, ec))
+    throw UserError(fmt::format("--save {}: {} exists and the profile names no defect map; to continue it, set "
+                                "correction.defect_map = \"{}\" in the profile, else move it away",
+                                save, where.map.string(), where.map.filename().string()),
+                    2);
+}
+
 void run_calibrate(const CalibrateArgs& args) {
-  if (!is_live_output(args.output)) return write_pattern_image(args);
+  const std::optional<DefectField> defects = defect_mode(args);
+  if (!is_live_output(args.output))
+    return defects ? write_defect_field_image(args, *defects) : write_pattern_image(args);
   if (args.output != "offscreen") refuse_gpu_for_live_output(args.gpu, "a live calibration");
   CalibrateSession session;
   session.output = args.output;
   session.gpu = args.gpu;
   session.pattern = args.pattern.empty() ? TestPattern::stripes : parse_pattern_option(args.pattern);
+  session.defects = defects;
   session.compositor = compositor_options(args);
   session.profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
   session.signal = resolve_signal(session.profile, args.signal);
   check_save_path(args.save);
+  if (defects) check_defect_map_target(session.profile, args.save);
   session.save = args.save;
   session.monitor = args.monitor;
   session.connector = args.connector;
@@ -131,7 +204,9 @@ void run_calibrate(const CalibrateArgs& args) {
 void add_calibrate_command(CLI::App& app) {
   auto args = std::make_shared<CalibrateArgs>();
   auto* cmd = app.add_subcommand(
-      "calibrate", "Tune a profile to your eyes with test patterns and keys (h for help), or write a pattern image");
+      "calibrate",
+      "Tune a profile to your eyes with test patterns and keys (h for help), or write a pattern image; "
+      "--defects marks dead and stuck pixels");
   cmd->add_option("--profile", args->profile, "Device profile to start from: built-in name or TOML file")
       ->capture_default_str();
   cmd->add_option("--output", args->output,
@@ -148,12 +223,23 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option(
       "--signal", args->signal,
       fmt::format("Output signal: {} (default: the profile's output.signal)", fmt::join(signal_names(), ", ")));
-  cmd->add_option("--fsaa", args->fsaa, "Antialiasing: 0, 1, 4 or 16 (as for convert)")->capture_default_str();
+  auto* fsaa =
+      cmd->add_option("--fsaa", args->fsaa, "Antialiasing: 0, 1, 4 or 16 (as for convert)")->capture_default_str();
   cmd->add_option("--gpu", args->gpu,
                   "EGL device index (image output only; a live output renders on its display's GPU)");
+  cmd->add_flag("--defects", args->defects,
+                "Find dead and stuck pixels: flat fields on the panels without the lens mapping, marked with keys "
+                "(h for help), the map saved beside the profile (its correction.defect_map, else FILE.defects "
+                "beside --save FILE.toml)");
+  cmd->add_option("--field", args->field,
+                  "With --defects: the flat field shown first, or written to an image --output (default black)")
+      ->check(CLI::IsMember(defect_field_names()));
   cmd->add_flag("-y,--overwrite", args->overwrite, "Replace the image --output if it exists");
   add_defect_compensation_option(*cmd, args->no_defect_compensation);
-  cmd->callback([args] { run_calibrate(*args); });
+  cmd->callback([args, fsaa] {
+    args->fsaa_given = fsaa->count() > 0;
+    run_calibrate(*args);
+  });
 }
 
 }  // namespace nelf::app

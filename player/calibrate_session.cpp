@@ -18,6 +18,7 @@
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/packing.hpp"
 #include "player/calibration_controls.hpp"
+#include "player/defect_session.hpp"
 #include "player/interrupt.hpp"
 #include "player/live_display.hpp"
 
@@ -203,6 +204,7 @@ class Session {
 }  // namespace
 
 void run_calibrate_session(const CalibrateSession& session) {
+  if (session.defects) return run_defect_session(session);
   try {
     CalibrationControls check(session.profile, session.pattern, 16.0 / 9.0);
   } catch (const ProfileError& e) {

@@ -137,6 +137,81 @@ const std::vector<KeyBinding>& key_bindings() {
        "quit (saves to --save)",
        "(also on closing the window or Ctrl-C; says where)",
        ""},
+
+      {S::defects, {{named(N::tab), C::next_eye}}, "Tab", "`Tab`", "the other eye", "(each eye keeps its cursor)", ""},
+      {S::defects,
+       {{named(N::left), C::cursor_left},
+        {named(N::right), C::cursor_right},
+        {named(N::up), C::cursor_up},
+        {named(N::down), C::cursor_down}},
+       "arrows",
+       "arrows",
+       "cursor 1 px (Shift 10 px, Ctrl 100 px)",
+       "(a crosshair with a gap: the pixel under it and its neighbours stay visible)",
+       ""},
+      {S::defects,
+       {{named(N::space), C::field_next},
+        {ch(U'1'), C::field_black},
+        {ch(U'2'), C::field_white},
+        {ch(U'3'), C::field_red},
+        {ch(U'4'), C::field_green},
+        {ch(U'5'), C::field_blue}},
+       "space 1-5",
+       "`space`, `1`-`5`",
+       "field colour: next / black, white, red, green, blue",
+       "(Shift+space back; stuck pixels stand out on black, dead ones on white)",
+       ""},
+      {S::defects,
+       {{ch(U'd'), C::mark_dead}, {ch(U'D'), C::mark_dead}},
+       "d",
+       "`d`",
+       "mark the pixel dead",
+       "(it shows black whatever it is sent)",
+       ""},
+      {S::defects,
+       {{ch(U's'), C::mark_stuck}, {ch(U'S'), C::mark_stuck}},
+       "s",
+       "`s`",
+       "mark the pixel stuck at the field's colour",
+       "(cycle the field until the pixel disappears into it, then `s`: one that vanishes on white is stuck "
+       "white)",
+       ""},
+      {S::defects,
+       {{ch(U'u'), C::unmark}, {ch(U'U'), C::unmark}, {named(N::backspace), C::unmark}},
+       "u Backspace",
+       "`u`, `Backspace`",
+       "unmark the pixel",
+       "",
+       ""},
+      {S::defects,
+       {{ch(U'n'), C::next_defect}, {ch(U'N'), C::next_defect}},
+       "n",
+       "`n`",
+       "cursor to the next marked pixel",
+       "(in the map's order, either eye)",
+       ""},
+      {S::defects,
+       {{ch(U't'), C::status_line}, {ch(U'T'), C::status_line}},
+       "t",
+       "`t`",
+       "status line on / off",
+       "(eye, x, y, field, defects; it moves away from the cursor)",
+       ""},
+      {S::defects, {{ch(U'w'), C::save}, {ch(U'W'), C::save}}, "w", "`w`", "save the defect map now", "", ""},
+      {S::defects,
+       {{ch(U'h'), C::help}, {ch(U'H'), C::help}, {ch(U'?'), C::help}},
+       "h",
+       "`h`",
+       "this help",
+       "(one line per press; all of it in the terminal)",
+       ""},
+      {S::defects,
+       {{named(N::escape), C::quit}, {ch(U'q'), C::quit}, {ch(U'Q'), C::quit}},
+       "q Esc",
+       "`q`, `Esc`",
+       "quit (saves the defect map)",
+       "(also on closing the window or Ctrl-C; says where)",
+       ""},
   };
   return table;
 }
@@ -160,14 +235,15 @@ std::vector<std::string> key_help(KeyScope scope) {
 }
 
 std::string key_table_markdown(KeyScope scope) {
+  const bool with_profile_key = scope == KeyScope::calibrate;
   std::string table =
-      scope == KeyScope::play ? "| key | does |\n|---|---|\n" : "| key | changes | profile key |\n|---|---|---|\n";
+      with_profile_key ? "| key | changes | profile key |\n|---|---|---|\n" : "| key | does |\n|---|---|\n";
   for (const KeyBinding& row : key_bindings()) {
     if (row.scope != scope) continue;
     std::string does(row.help);
     if (!row.detail.empty()) does += fmt::format(" {}", row.detail);
-    table += scope == KeyScope::play ? fmt::format("| {} | {} |\n", row.markdown_label, does)
-                                     : fmt::format("| {} | {} | {} |\n", row.markdown_label, does, row.profile_key);
+    table += with_profile_key ? fmt::format("| {} | {} | {} |\n", row.markdown_label, does, row.profile_key)
+                              : fmt::format("| {} | {} |\n", row.markdown_label, does);
   }
   return table;
 }

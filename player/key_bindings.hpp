@@ -1,7 +1,7 @@
 #pragma once
-// Keys → commands for `nelf play` and `nelf calibrate`: one table (key_bindings.cpp), from which
-// the loops take what a key press means, and the on-screen and terminal help (h) and the README's
-// key tables are made, so that none of them can drift from what the keys do.
+// Keys → commands for `nelf play`, `nelf calibrate` and `nelf calibrate --defects`: one table (key_bindings.cpp), from
+// which the loops take what a key press means, and the on-screen and terminal help (h) and the README's key tables are
+// made, so that none of them can drift from what the keys do.
 #include <optional>
 #include <string>
 #include <string_view>
@@ -12,7 +12,8 @@
 
 namespace nelf {
 
-enum class KeyScope { play, calibrate };
+// calibrate: the test patterns through the lenses; defects: the flat fields of --defects.
+enum class KeyScope { play, calibrate, defects };
 
 enum class Command {
   quit,
@@ -49,6 +50,22 @@ enum class Command {
   pattern_snellen,
   pattern_white,
   save,
+  // defects (Tab: next_eye)
+  cursor_left,
+  cursor_right,
+  cursor_up,
+  cursor_down,
+  field_next,
+  field_black,
+  field_white,
+  field_red,
+  field_green,
+  field_blue,
+  mark_dead,
+  mark_stuck,
+  unmark,
+  next_defect,
+  status_line,
 };
 
 // One line of help: the keys it names and what each does.
@@ -71,7 +88,7 @@ std::optional<Command> command_for(KeyScope scope, const KeyPress& key);
 // "label: help", one line per row of `scope`.
 std::vector<std::string> key_help(KeyScope scope);
 
-// The README's table of `scope`'s keys (play: key | does; calibrate: key | changes | profile key).
+// The README's table of `scope`'s keys (play, defects: key | does; calibrate: key | changes | profile key).
 std::string key_table_markdown(KeyScope scope);
 
 }  // namespace nelf

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "optics/profile.hpp"
 #include "support/image_files.hpp"
 #include "support/test_support.hpp"
 
@@ -104,6 +105,50 @@ TEST(CalibrateCli, ProfileAndSignalOptions) {
   EXPECT_EQ(img.height, 720);
 }
 
+TEST(CalibrateCli, DefectsWritesThePackedFlatFieldWithTheKnownDefectsRinged) {
+  // --defects --output FILE: the field on every panel pixel (no lens mapping), a ring 2 px around
+  // each defect of the profile's map (whole: dead, dotted: stuck), the defect pixels themselves
+  // and everything else the field, the gap rows black.
+  TempDir dir;
+  Profile profile = load_profile("hmz-t1");
+  profile.correction.defect_map = "panel.defects";
+  test::write_file(dir / "panel.defects", "left 100 100 dead\nright 200 50 stuck 255 255 255\n");
+  test::write_file(dir / "mine.toml", profile_to_toml(profile));
+  const auto out = dir / "red.png";
+  const auto r = run_nelf("calibrate --defects --field red --profile " + shell_quote((dir / "mine.toml").string()) +
+                          " --output " + shell_quote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const auto img = read_back(out);
+  ASSERT_EQ(img.width, 1280);
+  ASSERT_EQ(img.height, 1470);
+  const auto is = [&](int x, int y, float red, float green, float blue) {
+    return img.at(x, y, 0) == red && img.at(x, y, 1) == green && img.at(x, y, 2) == blue;
+  };
+  long left_rings = 0, right_rings = 0, other = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      if (y >= 720 && y < 750) {
+        other += !is(x, y, 0, 0, 0);
+      } else if (is(x, y, 0, 1, 1)) {
+        (y < 720 ? left_rings : right_rings) += 1;
+      } else {
+        other += !is(x, y, 1, 0, 0);
+      }
+    }
+  EXPECT_EQ(other, 0);
+  EXPECT_EQ(left_rings, 16);  // the 5x5 square's outline
+  EXPECT_EQ(right_rings, 8);  // every other pixel of it
+  EXPECT_TRUE(is(100, 100, 1, 0, 0));
+  EXPECT_TRUE(is(102, 100, 0, 1, 1));
+  EXPECT_TRUE(is(200, 750 + 50, 1, 0, 0));
+  EXPECT_TRUE(is(202, 750 + 52, 0, 1, 1));
+  // The default field is black.
+  const auto black = dir / "black.png";
+  ASSERT_EQ(run_nelf("calibrate --defects --output " + shell_quote(black.string())).status, 0);
+  EXPECT_EQ(lit_pixels(read_back(black), 0, 1470), 0);
+}
+
 TEST(CalibrateCli, BadArgumentsSayWhatAndWriteNothing) {
   TempDir dir;
   const std::string out = shell_quote((dir / "p.png").string());
@@ -127,6 +172,13 @@ TEST(CalibrateCli, BadArgumentsSayWhatAndWriteNothing) {
        "nelf: --save keeps what the keys adjusted and needs a window"},
       {"--pattern grid --fsaa 3 --output " + out, 2, "fsaa"},
       {"--pattern grid --gpu 0", 2, "a live calibration renders on its display's GPU"},
+      {"--field white --output " + out, 2, "nelf: --field white is the flat field of --defects: add --defects"},
+      {"--defects --pattern grid --output " + out, 2, "nelf: --defects shows flat fields, not --pattern grid"},
+      {"--defects --fsaa 4 --output " + out, 2, "nelf: --fsaa antialiases the lens mapping"},
+      {"--defects --field pink --output " + out, 2, "pink not in {black,white,red,green,blue}"},
+      {"--defects --save " + shell_quote((dir / "x.toml").string()) + " --output " + out, 2,
+       "nelf: --save keeps what the keys marked and needs a window"},
+      {"--defects --save " + shell_quote((dir / "x.txt").string()), 2, "a profile is a .toml file"},
   };
   for (const auto& c : cases) {
     const auto r = run_nelf("calibrate " + c.args);
@@ -135,6 +187,20 @@ TEST(CalibrateCli, BadArgumentsSayWhatAndWriteNothing) {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << ": " << r.err;
     EXPECT_EQ(files_in(dir.path()), std::vector<std::string>{}) << c.args;
   }
+}
+
+TEST(CalibrateCli, DefectsKeepsAMapTheProfileDoesNotName) {
+  // mine.defects beside --save mine.toml, not named by the profile: refused before any window
+  // opens, the file left as it was.
+  TempDir dir;
+  test::write_file(dir / "mine.defects", "left 1 1 dead\n");
+  const auto r = run_nelf("calibrate --defects --output offscreen --save " + shell_quote((dir / "mine.toml").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err, "nelf: --save " + (dir / "mine.toml").string() + ": " + (dir / "mine.defects").string() +
+                       " exists and the profile names no defect map; to continue it, set correction.defect_map = "
+                       "\"mine.defects\" in the profile, else move it away\n");
+  EXPECT_EQ(test::read_file(dir / "mine.defects"), "left 1 1 dead\n");
+  EXPECT_EQ(files_in(dir.path()), std::vector<std::string>{"mine.defects"});
 }
 
 TEST(CalibrateCli, UnwritableOutputLeavesNoFile) {

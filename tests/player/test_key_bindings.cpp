@@ -8,13 +8,14 @@
 #include <string>
 
 #include "player/calibration_controls.hpp"
+#include "player/defect_marking.hpp"
 #include "player/key_bindings.hpp"
 
 namespace nelf {
 namespace {
 
 TEST(KeyBindings, NoKeyMeansTwoThingsInOneScope) {
-  for (const KeyScope scope : {KeyScope::play, KeyScope::calibrate}) {
+  for (const KeyScope scope : {KeyScope::play, KeyScope::calibrate, KeyScope::defects}) {
     std::set<std::pair<int, char32_t>> seen;
     for (const KeyBinding& row : key_bindings()) {
       if (row.scope != scope) continue;
@@ -34,6 +35,13 @@ TEST(KeyBindings, KeysMeanWhatTheHelpSays) {
   EXPECT_EQ(command_for(KeyScope::calibrate, KeyPress::of(U'R')), Command::rotate_more);
   EXPECT_EQ(command_for(KeyScope::calibrate, KeyPress::of(U's')), std::nullopt);  // play's, not calibrate's
   EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U'r')), std::nullopt);
+  // --defects: d and s mark (calibrate's d is the prescription), arrows move the cursor.
+  EXPECT_EQ(command_for(KeyScope::defects, KeyPress::of(U'd')), Command::mark_dead);
+  EXPECT_EQ(command_for(KeyScope::calibrate, KeyPress::of(U'd')), Command::prescription_less);
+  EXPECT_EQ(command_for(KeyScope::defects, KeyPress::of(U's')), Command::mark_stuck);
+  EXPECT_EQ(command_for(KeyScope::defects, KeyPress::of(KeyPress::Named::backspace)), Command::unmark);
+  EXPECT_EQ(command_for(KeyScope::defects, KeyPress::of(KeyPress::Named::up)), Command::cursor_up);
+  EXPECT_EQ(command_for(KeyScope::defects, KeyPress::of(U'r')), std::nullopt);
   // Shift+arrow is still the arrow (calibrate's fine shift); Ctrl+q is not q.
   KeyPress shifted = KeyPress::of(KeyPress::Named::left);
   shifted.shift = true;
@@ -49,6 +57,8 @@ TEST(KeyBindings, HelpIsOneLinePerRow) {
   EXPECT_EQ(play.back(), "q Esc: quit");
   EXPECT_EQ(CalibrationControls::help_lines(), key_help(KeyScope::calibrate));
   EXPECT_EQ(CalibrationControls::help_lines().front(), "Tab: adjust both eyes / left / right");
+  EXPECT_EQ(DefectMarking::help_lines(), key_help(KeyScope::defects));
+  EXPECT_EQ(DefectMarking::help_lines().back(), "q Esc: quit (saves the defect map)");
 }
 
 TEST(KeyBindings, ReadmeTablesAreTheTable) {
@@ -56,7 +66,7 @@ TEST(KeyBindings, ReadmeTablesAreTheTable) {
   ASSERT_TRUE(in) << "README.md not found";
   std::stringstream readme;
   readme << in.rdbuf();
-  for (const KeyScope scope : {KeyScope::play, KeyScope::calibrate}) {
+  for (const KeyScope scope : {KeyScope::play, KeyScope::calibrate, KeyScope::defects}) {
     const std::string table = key_table_markdown(scope);
     EXPECT_NE(readme.str().find(table), std::string::npos)
         << "README.md lacks (or has another version of) this table:\n"

@@ -16,6 +16,7 @@
 #include <thread>
 #include <utility>
 
+#include "optics/defect_map.hpp"
 #include "optics/mapping.hpp"
 #include "optics/profile.hpp"
 #include "support/image_files.hpp"
@@ -247,6 +248,42 @@ TEST_F(CalibrateWindowTest, ClosingTheWindowSavesAndExitsCleanly) {
   ASSERT_TRUE(status) << "nelf calibrate did not end when its window was closed";
   EXPECT_EQ(*status, 0) << test::read_file(dir_ / "err.txt");
   EXPECT_EQ(load_profile(saved.string()).correction.prescription_diopters, 0.5);
+}
+
+TEST_F(CalibrateWindowTest, DefectsKeysMarkPixelsAndSaveTheMapBesideTheProfile) {
+  // --defects from the built-in (no map named): the marks go to mine.defects beside --save
+  // mine.toml, which names it. The cursor starts at the centre of the left panel (640, 360).
+  const auto saved = dir_ / "mine.toml";
+  NelfProcess nelf("calibrate --defects --save " + shell_quote(saved.string()), dir_ / "out.txt", dir_ / "err.txt");
+  const std::string window = find_window(nelf);
+  ASSERT_FALSE(window.empty()) << test::read_file(dir_ / "err.txt");
+  // Left (640, 360) dead; 11 px right on the white field stuck white; the right eye 100 px up and
+  // 1 left on the green field (space: white -> red -> green) stuck green; one more right, dead,
+  // then unmarked with Backspace; a pixel on the left eye marked and unmarked with u; w; q.
+  keys(window, "d Right shift+Right 2 s Tab ctrl+Up Left space space s Right d BackSpace Tab Down d u w q");
+  const auto status = nelf.wait(std::chrono::seconds(30));
+  ASSERT_TRUE(status) << "nelf calibrate --defects did not quit on q";
+  const std::string out = test::read_file(dir_ / "out.txt");
+  EXPECT_EQ(*status, 0) << out << test::read_file(dir_ / "err.txt");
+  EXPECT_EQ(test::read_file(dir_ / "err.txt"), "");
+  EXPECT_NE(out.find("nelf calibrate: marked left 640 360 dead (1 defect)\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("nelf calibrate: unmarked right 640 260 dead (3 defects)\n"), std::string::npos) << out;
+  const std::string line =
+      fmt::format("saved 3 defects to {} and {} naming it\n", (dir_ / "mine.defects").string(), saved.string());
+  const auto first = out.find(line);
+  ASSERT_NE(first, std::string::npos) << out;
+  EXPECT_NE(out.find(line, first + 1), std::string::npos) << "w and the quit both save: " << out;
+
+  EXPECT_EQ(test::read_file(dir_ / "mine.defects"),
+            "# nelf defect map: EYE COLUMN ROW dead | EYE COLUMN ROW stuck R G B (row 0 the top; docs/defects.md)\n"
+            "left 640 360 dead\n"
+            "left 651 360 stuck 255 255 255\n"
+            "right 639 260 stuck 0 255 0\n");
+  const Profile p = load_profile(saved.string());
+  EXPECT_EQ(p.name, "mine");
+  EXPECT_EQ(p.correction.defect_map, "mine.defects");
+  ASSERT_TRUE(p.correction.defects);
+  EXPECT_EQ(p.correction.defects->defects.size(), 3u);
 }
 
 TEST(CalibrateWindowErrors, NoDisplayIsOneLineAndNothingSaved) {
