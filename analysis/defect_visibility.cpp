@@ -12,8 +12,6 @@ namespace {
 
 constexpr double degrees_per_radian = 180.0 / std::numbers::pi;
 
-float channel(std::uint8_t value) { return static_cast<float>(value) / 255.f; }
-
 double luminance(const Rgba& p) { return (static_cast<double>(p.r) + p.g + p.b) / 3.0; }
 
 void check_panel_size(const Image& image, std::array<int, 2> panel, const char* what) {
@@ -30,33 +28,14 @@ struct Spot {
 }  // namespace
 
 Image defective_display(const DefectMap& map, Eye eye, Image sent) {
-  for (const PixelDefect& d : map.defects) {
-    if (d.eye != eye || d.x >= sent.width() || d.y >= sent.height()) continue;
-    const auto rgb = d.shown_rgb();
-    sent.at(d.x, d.y) = {channel(rgb[0]), channel(rgb[1]), channel(rgb[2]), 1.f};
-  }
+  show_defects(map, eye, sent);
   return sent;
 }
 
 Image compensated_display(const EyeDefectPlan& plan, const Image& sent) {
   check_panel_size(sent, plan.panel, "compensated_display: the eye image");
   Image out = sent;
-  for (const DefectCorrection& c : plan.corrections) {
-    const Rgba& should = sent.at(c.defect.x, c.defect.y);
-    const auto shows = c.defect.shown_rgb();
-    const float missing[3] = {should.r - channel(shows[0]), should.g - channel(shows[1]), should.b - channel(shows[2])};
-    for (const BundleShare& s : c.shares) {
-      Rgba& p = out.at(s.x, s.y);
-      p.r += s.weight * missing[0];
-      p.g += s.weight * missing[1];
-      p.b += s.weight * missing[2];
-    }
-  }
-  for (Rgba& p : out.pixels()) {
-    p.r = std::clamp(p.r, 0.f, 1.f);
-    p.g = std::clamp(p.g, 0.f, 1.f);
-    p.b = std::clamp(p.b, 0.f, 1.f);
-  }
+  compensate_defects(plan, out);
   return out;
 }
 

@@ -16,12 +16,12 @@
 namespace nelf {
 
 // What the panel shows when sent `sent` (one eye's image, panel size): each defect of `map` on `eye`
-// shows what it shows (black for a dead pixel) whatever it was sent.
+// shows what it shows (black for a dead pixel) whatever it was sent (show_defects on a copy).
 Image defective_display(const DefectMap& map, Eye eye, Image sent);
 
 // `sent` with the corrections of `plan` added: each share's pixel gets weight × (what the defect was
 // sent − what it shows), the corrections all worked out from `sent` as given, each pixel clipped to
-// [0, 1]. The measurement's own statement of the per-frame step, so that it judges the plan alone.
+// [0, 1]: the per-frame step every output takes (compensate_defects), on a copy.
 Image compensated_display(const EyeDefectPlan& plan, const Image& sent);
 
 struct DefectSpotFigures {
