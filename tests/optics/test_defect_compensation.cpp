@@ -1,7 +1,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <set>
 
 #include "optics/defect_compensation.hpp"
@@ -127,24 +126,19 @@ TEST(DefectCompensation, AStockDeviceHasNoBundles) {
   EXPECT_EQ(eye_box_width_mm(m), 0.0);
 }
 
-TEST(DefectCompensation, AThousandDefectsPlanQuickly) {
+TEST(DefectCompensation, AThousandDefectsAllGetAPlan) {
   const EyeMapping& m = hmz_t1_left();
   // About 1000 of hmz-t1's lit pixels.
   const DefectMap map = test::random_defect_map(m, 1000.0 / (m.panel[0] * m.panel[1] * lit_fraction(m)), 0.0, 7);
   ASSERT_GT(map.defects.size(), 900u);
   ASSERT_LT(map.defects.size(), 1100u);
-  const auto start = std::chrono::steady_clock::now();
+  // (How long planning takes is measured by hand, not bounded here: about 0.1 s, docs/defects.md.)
   const EyeDefectPlan plan = plan_defect_compensation(m, map);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // Measured about 0.1 s (RelWithDebInfo); the bound leaves room for the sanitizer build.
-  EXPECT_LT(seconds, 3.0);
   EXPECT_EQ(plan.outside_lit, 0);
   EXPECT_GT(plan.corrections.size(), map.defects.size() * 9 / 10);
   std::size_t shares = 0;
   for (const DefectCorrection& c : plan.corrections) shares += c.shares.size();
-  RecordProperty("plan_seconds", std::to_string(seconds));
-  RecordProperty("shares", std::to_string(shares));
-  std::printf("planned %zu defects in %.3f s, %zu shares\n", map.defects.size(), seconds, shares);
+  EXPECT_GT(shares, plan.corrections.size());
 }
 
 }  // namespace
