@@ -75,6 +75,19 @@ StereoPair pattern_views(TestPattern pattern, const Profile& profile) {
   }
 }
 
+// The image --output's write options, the file checked writable before anything is composited
+// (status 1 when it is not).
+ImageWriteOptions checked_image_output(const CalibrateArgs& args) {
+  ImageWriteOptions write;
+  write.overwrite = args.overwrite;
+  try {
+    check_image_writable(args.output, write);
+  } catch (const ImageWriteError& e) {
+    throw UserError(e.what(), 1);
+  }
+  return write;
+}
+
 // Headless: the packed frame of one pattern as an image file.
 void write_pattern_image(const CalibrateArgs& args) {
   if (args.pattern.empty())
@@ -93,13 +106,7 @@ void write_pattern_image(const CalibrateArgs& args) {
   const CompositorOptions options = compositor_options(args);
   const Profile profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
   const Signal signal = resolve_signal(profile, args.signal);
-  ImageWriteOptions write;
-  write.overwrite = args.overwrite;
-  try {
-    check_image_writable(args.output, write);
-  } catch (const ImageWriteError& e) {
-    throw UserError(e.what(), 1);
-  }
+  const ImageWriteOptions write = checked_image_output(args);
   write_packed_still(pattern_views(pattern, profile), profile, signal, options, args.output, write);
 }
 
@@ -135,13 +142,7 @@ void write_defect_field_image(const CalibrateArgs& args, DefectField field) {
   inputs.refuse_as_output(args.output);
   const Profile profile = load_profile(args.profile);  // ProfileError -> status 2 in main()
   const Signal signal = resolve_signal(profile, args.signal);
-  ImageWriteOptions write;
-  write.overwrite = args.overwrite;
-  try {
-    check_image_writable(args.output, write);
-  } catch (const ImageWriteError& e) {
-    throw UserError(e.what(), 1);
-  }
+  const ImageWriteOptions write = checked_image_output(args);
   const DefectMap known = profile.correction.defects ? *profile.correction.defects : DefectMap{};
   const EyeImages panels = {DefectMarking::field_image(profile.display.resolution, field, known, Eye::left),
                             DefectMarking::field_image(profile.display.resolution, field, known, Eye::right)};
