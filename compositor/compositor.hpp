@@ -14,8 +14,10 @@ namespace nelf {
 
 // Where the content's depth comes from (`--depth`): off, the flat emulated screen for everything;
 // auto, the depth a frame carries (StereoVideoFrame::disparity: a synthetic scene's exact depth),
-// the flat screen for frames without it.
-enum class DepthMode { off, automatic };
+// estimated from the two views for frames without it; estimate, always estimated from the two views
+// (inputs/stereo_matcher), even where the source knows better. The compositor composites with
+// whatever disparity a frame carries; the player attaches the estimate (the compositor never matches).
+enum class DepthMode { off, automatic, estimate };
 // The names `--depth` takes, in order, and the mode of one (nothing for an unknown name).
 const std::vector<std::string>& depth_mode_names();
 std::optional<DepthMode> parse_depth_mode(std::string_view name);

@@ -17,17 +17,28 @@ void validate_fsaa(int fsaa) {
 }
 
 const std::vector<std::string>& depth_mode_names() {
-  static const std::vector<std::string> names{"off", "auto"};
+  static const std::vector<std::string> names{"off", "auto", "estimate"};
   return names;
 }
 
 std::optional<DepthMode> parse_depth_mode(std::string_view name) {
   if (name == "off") return DepthMode::off;
   if (name == "auto") return DepthMode::automatic;
+  if (name == "estimate") return DepthMode::estimate;
   return std::nullopt;
 }
 
-std::string_view depth_mode_name(DepthMode mode) { return mode == DepthMode::off ? "off" : "auto"; }
+std::string_view depth_mode_name(DepthMode mode) {
+  switch (mode) {
+    case DepthMode::off:
+      return "off";
+    case DepthMode::automatic:
+      return "auto";
+    case DepthMode::estimate:
+      return "estimate";
+  }
+  return "off";
+}
 
 Rgba sample_bilinear(const Image& image, double u, double t) {
   const double x = u * image.width() - 0.5, y = t * image.height() - 0.5;

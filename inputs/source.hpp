@@ -15,6 +15,7 @@
 #include "core/frames.hpp"
 #include "core/pixel_limit.hpp"
 #include "inputs/stereo_layout.hpp"
+#include "optics/profile.hpp"
 
 namespace nelf {
 
@@ -28,6 +29,9 @@ struct SourceRequest {
   bool quiet = false;                           // no line describing the input (warnings are printed all the same)
   bool allow_network = false;                   // FFmpeg protocols beyond file and pipe
   std::int64_t max_pixels = kDefaultMaxPixels;  // --max-pixels: larger frames are refused undecoded
+  // The display the frames are shown on, when known: a synthetic scene films itself for its
+  // emulated screen (matched_to_display), so that the depth it knows is the depth the viewer sees.
+  std::shared_ptr<const Profile> display;
 };
 
 // What a source says about its stream once it is open.
