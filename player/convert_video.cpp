@@ -109,7 +109,7 @@ std::unique_ptr<FrameSink> open_frame_sink(const VideoConvertRequest& r, Source&
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
   std::unique_ptr<Source> source = open_source(
-      SourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels});
+      SourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels, nullptr});
   // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
   const ViewGeometry view = source->info().view;
   source->negotiate({stereo_prefilter_block(r.profile, r.compositor, view.width, view.height, view.aspect)});
