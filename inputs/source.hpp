@@ -31,7 +31,7 @@ struct SourceRequest {
   std::int64_t max_pixels = kDefaultMaxPixels;  // --max-pixels: larger frames are refused undecoded
   // The display the frames are shown on, when known: a synthetic scene films itself for its
   // emulated screen (matched_to_display), so that the depth it knows is the depth the viewer sees.
-  std::shared_ptr<const Profile> display;
+  std::shared_ptr<const Profile> display = nullptr;  // initialised: positional SourceRequest{…} may end before it
 };
 
 // What a source says about its stream once it is open.
