@@ -1,5 +1,6 @@
 // `nelf profiles`: the built-in device profiles.
 #include <fmt/format.h>
+#include <algorithm>
 
 #include "app/commands.hpp"
 #include "optics/profile.hpp"
@@ -9,7 +10,9 @@ namespace nelf::app {
 void add_profiles_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("profiles", "List the built-in device profiles");
   cmd->callback([] {
-    for (const auto& p : builtin_profiles()) fmt::print("{:<14} {}\n", p.name, p.description);
+    std::size_t width = 0;
+    for (const auto& p : builtin_profiles()) width = std::max(width, p.name.size());
+    for (const auto& p : builtin_profiles()) fmt::print("{:<{}} {}\n", p.name, width, p.description);
   });
 }
 

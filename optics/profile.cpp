@@ -66,7 +66,10 @@ const std::vector<std::string>& known_keys() {
 }
 
 const std::vector<std::string>& known_signals() {
-  static const std::vector<std::string> signals = {"hdmi-fp-720p60", "hdmi-fp-720p50", "hdmi-fp-1080p24"};
+  // The HDMI 1.4a frame-packed modes, and the plain layouts that follow the panel's size (for panels
+  // larger than any frame-packed mode, such as the film prototypes: files and previews).
+  static const std::vector<std::string> signals = {"hdmi-fp-720p60", "hdmi-fp-720p50", "hdmi-fp-1080p24", "sbs", "tab",
+                                                   "left",           "right"};
   return signals;
 }
 

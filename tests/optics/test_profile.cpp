@@ -1,9 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <array>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "optics/mapping.hpp"
 #include "optics/profile.hpp"
 
 namespace nelf {
@@ -52,10 +54,29 @@ TEST(Profile, BuiltinStockHasNoLensArray) {
   EXPECT_FALSE(p.screen.converge);
 }
 
-TEST(Profile, BuiltinListNamesBoth) {
+TEST(Profile, BuiltinListNamesEach) {
   const auto list = builtin_profiles();
-  ASSERT_EQ(list.size(), 2u);
+  ASSERT_EQ(list.size(), 4u);
   for (const auto& b : list) EXPECT_FALSE(b.description.empty()) << b.name;
+}
+
+TEST(Profile, TheFinerDisplaysOfTheDepthIssueLoad) {
+  // The paper's LVT film prototype and a published 2160 x 2160 integral-imaging testbed (issue #15):
+  // panels larger than any frame-packed mode, so their output is side by side.
+  const Profile lvt = load_profile("lvt-prototype");
+  EXPECT_EQ(lvt.display.resolution, (std::array<int, 2>{4500, 4500}));
+  EXPECT_DOUBLE_EQ(lvt.display.pixel_pitch_mm.x, 0.00833);
+  ASSERT_TRUE(lvt.lens_array);
+  EXPECT_DOUBLE_EQ(lvt.lens_array->focal_length_mm, 3.3);
+  EXPECT_DOUBLE_EQ(lvt.viewing.eye_relief_mm, 25.0);
+  EXPECT_EQ(lvt.signal, "sbs");
+  const Profile ii = load_profile("ii-2160-testbed");
+  EXPECT_EQ(ii.display.resolution, (std::array<int, 2>{2160, 2160}));
+  ASSERT_TRUE(ii.lens_array);
+  EXPECT_DOUBLE_EQ(ii.lens_array->pitch_mm, 1.2);
+  EXPECT_DOUBLE_EQ(lens_gap_mm(ii), 6.316);
+  EXPECT_DOUBLE_EQ(ii.viewing.eye_relief_mm, 20.0);
+  EXPECT_EQ(ii.signal, "sbs");
 }
 
 TEST(Profile, DefaultsForOptionalTables) {
