@@ -78,9 +78,21 @@ class SyntheticClip {
     double swing_x, swing_z, phase;
     Rgba colour;
   };
-  Image render_eye(double eye_x_mm, double t) const;
+  // The front-most surface a ray from the eye at (eye_x_mm, 0, 0) through `screen` (mm on the
+  // zero-parallax screen) meets: its colour and its distance z.
+  struct Surface {
+    Rgba colour;
+    double z;
+  };
+  double screen_width_mm() const;
+  Vec2 screen_point_mm(double x, double y) const;
+  std::vector<Sphere> spheres_at(double t) const;
+  Surface surface(const std::vector<Sphere>& now, double eye_x_mm, Vec2 screen) const;
+  Image render_eye(double eye_x_mm, double t, int samples) const;
+  std::vector<double> depth_mm(double eye_x_mm, double t) const;  // per view pixel centre
   SyntheticClipSettings settings_;
   std::vector<Sphere> spheres_;
+  StereoPair planes_pair_;  // the planes scene is still: rendered once
 };
 
 }  // namespace nelf
