@@ -185,6 +185,8 @@ EyeSimulator::EyeSimulator(DeviceOptics device, const EyeMapping& rendering, con
       screen_size_mm_(rendering.screen_size_mm),
       field_(visual_field_for_screen(rendering, options)) {
   if (view.empty()) throw std::invalid_argument("eye simulator: empty view");
+  view_width_ = view.width();
+  view_height_ = view.height();
   if (!(device_.lens_pitch_mm > 0.0) || !(device_.focal_mm > 0.0) || !(device_.gap_mm > 0.0) ||
       !(device_.eye_relief_mm > 0.0))
     throw std::invalid_argument("eye simulator: device optics need positive pitch, focal length, gap, eye relief");
@@ -276,23 +278,32 @@ std::vector<Rgba> EyeSimulator::retina_at(const Image& displayed, const EyeModel
   return out;
 }
 
-Image EyeSimulator::ideal(const EyeModel& eye) const {
+Image EyeSimulator::ideal(const EyeModel& eye, const SceneDepth* scene) const {
   validate_eye_model(eye);
   const auto pupil = pupil_samples(eye.pupil_mm, eye.pupil_samples_per_axis);
   const double inv_focus = 1.0 / eye.focus_mm;
   const double d_r = render_distance_mm_;
   const double weight = 1.0 / static_cast<double>(pupil.size());
+  const DisparitySurface* surface =
+      scene && scene->surface && !scene->surface->unknown() ? scene->surface.get() : nullptr;
+  // Per pupil sample, the shift of the view per unit of disparity for rays through that point.
+  std::vector<Vec2> gains;
+  if (surface)
+    for (const Vec2& rho : pupil)
+      gains.push_back(pupil_gain(scene->geometry, {eye.offset_mm.x + rho.x, eye.offset_mm.y + rho.y}));
   Image out(field_.width, field_.height);
   for_each_row(field_.height, [&](int j) {
     for (int i = 0; i < field_.width; ++i) {
       double r = 0, g = 0, b = 0;
-      for (const Vec2& rho : pupil) {
+      for (std::size_t k = 0; k < pupil.size(); ++k) {
+        const Vec2& rho = pupil[k];
         const double vx = eye.offset_mm.x + rho.x + (tan_x_[i] - rho.x * inv_focus) * d_r;
         const double vy = eye.offset_mm.y + rho.y + (tan_y_[j] - rho.y * inv_focus) * d_r;
-        const double u = (vx - screen_centre_mm_.x) / screen_size_mm_.x + 0.5;
-        const double t = 0.5 - (vy - screen_centre_mm_.y) / screen_size_mm_.y;
-        if (u < 0.0 || u > 1.0 || t < 0.0 || t > 1.0) continue;  // beside the screen: black
-        const Rgba p = sample_bilinear(band_limited_view_, u, t);
+        Vec2 uv{(vx - screen_centre_mm_.x) / screen_size_mm_.x + 0.5,
+                0.5 - (vy - screen_centre_mm_.y) / screen_size_mm_.y};
+        if (surface) uv = surface->hit(uv, gains[k]);
+        if (uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0) continue;  // beside the screen: black
+        const Rgba p = sample_bilinear(band_limited_view_, uv.x, uv.y);
         r += p.r, g += p.g, b += p.b;
       }
       out.at(i, j) = {static_cast<float>(r * weight), static_cast<float>(g * weight), static_cast<float>(b * weight),
@@ -300,6 +311,35 @@ Image EyeSimulator::ideal(const EyeModel& eye) const {
     }
   });
   return out;
+}
+
+std::vector<std::uint8_t> EyeSimulator::view_region_mask(const EyeModel& eye,
+                                                         const std::vector<std::uint8_t>& view_mask,
+                                                         const SceneDepth* scene) const {
+  if (view_mask.size() != static_cast<std::size_t>(view_width_) * static_cast<std::size_t>(view_height_))
+    throw std::invalid_argument(fmt::format("eye simulator: a region mask of {} values for a {}x{} view",
+                                            view_mask.size(), view_width_, view_height_));
+  const DisparitySurface* surface =
+      scene && scene->surface && !scene->surface->unknown() ? scene->surface.get() : nullptr;
+  const Vec2 gain = surface ? pupil_gain(scene->geometry, eye.offset_mm) : Vec2{};
+  std::vector<std::uint8_t> mask(static_cast<std::size_t>(field_.width) * static_cast<std::size_t>(field_.height), 0);
+  for (int j = 0; j < field_.height; ++j) {
+    for (int i = 0; i < field_.width; ++i) {
+      const double vx = eye.offset_mm.x + tan_x_[i] * render_distance_mm_;
+      const double vy = eye.offset_mm.y + tan_y_[j] * render_distance_mm_;
+      Vec2 uv{(vx - screen_centre_mm_.x) / screen_size_mm_.x + 0.5,
+              0.5 - (vy - screen_centre_mm_.y) / screen_size_mm_.y};
+      if (surface) uv = surface->hit(uv, gain);
+      if (uv.x < 0.0 || uv.x >= 1.0 || uv.y < 0.0 || uv.y >= 1.0) continue;
+      const int x = std::min(view_width_ - 1, static_cast<int>(uv.x * view_width_));
+      const int y = std::min(view_height_ - 1, static_cast<int>(uv.y * view_height_));
+      mask[static_cast<std::size_t>(j) * static_cast<std::size_t>(field_.width) + static_cast<std::size_t>(i)] =
+          view_mask[static_cast<std::size_t>(y) * static_cast<std::size_t>(view_width_) + static_cast<std::size_t>(x)]
+              ? 1
+              : 0;
+    }
+  }
+  return mask;
 }
 
 std::vector<std::uint8_t> EyeSimulator::on_screen_mask(const EyeModel& eye) const {
@@ -351,10 +391,10 @@ std::vector<std::uint8_t> EyeSimulator::clear_field_mask(double pupil_mm) const 
   return mask;
 }
 
-SimulationResult EyeSimulator::simulate(const Image& displayed, const EyeModel& eye) const {
+SimulationResult EyeSimulator::simulate(const Image& displayed, const EyeModel& eye, const SceneDepth* scene) const {
   SimulationResult result;
   result.retina = retina(displayed, eye);
-  result.ideal = ideal(eye);
+  result.ideal = ideal(eye, scene);
   const auto on_screen = on_screen_mask(eye);
   result.evaluated = clear_field_mask(eye.pupil_mm);
   std::size_t on_screen_count = 0, evaluated_count = 0;

@@ -12,9 +12,11 @@
 // lens_array) rather than the calibration.
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "core/image.hpp"
+#include "optics/depth.hpp"
 #include "optics/mapping.hpp"
 #include "optics/profile.hpp"
 
@@ -79,6 +81,17 @@ struct SimulationResult {
   double evaluated_fraction = 0;  // evaluated pixels / on-screen pixels
 };
 
+// The real scene, when the source knows its depth (issue #15): the view taken from the pupil's
+// centre and its exact disparity. A ray through the pupil at P shows the view where it meets that
+// surface (optics/depth.hpp's search), so an eye focused at a plane's distance sees that plane sharp
+// and the others blurred by their own defocus, as it would in front of the scene itself. Exact for
+// fronto-parallel planes, except in the thin strips a near plane hides from the pupil's centre
+// (there the search finds the surface the centre sees).
+struct SceneDepth {
+  std::shared_ptr<const DisparitySurface> surface;
+  DepthGeometry geometry;
+};
+
 class EyeSimulator {
  public:
   // `rendering` is the mapping the displayed images were (or will be) composited with: it supplies the
@@ -86,12 +99,18 @@ class EyeSimulator {
   // `view` is the source view shown on that screen. `device` is the physical optics the eye looks through.
   EyeSimulator(DeviceOptics device, const EyeMapping& rendering, const Image& view, SimulatorOptions options = {});
 
-  // Traces the eye through the lens array onto `displayed` (panel resolution) and onto the screen.
-  SimulationResult simulate(const Image& displayed, const EyeModel& eye) const;
+  // Traces the eye through the lens array onto `displayed` (panel resolution) and onto the screen,
+  // or, given `scene`, onto the real scene (the ideal an eye sees in front of it).
+  SimulationResult simulate(const Image& displayed, const EyeModel& eye, const SceneDepth* scene = nullptr) const;
 
   // The two halves of simulate(), for callers that need only one.
   Image retina(const Image& displayed, const EyeModel& eye) const;
-  Image ideal(const EyeModel& eye) const;
+  Image ideal(const EyeModel& eye, const SceneDepth* scene = nullptr) const;
+  // Per retinal pixel, 1 where the chief ray from the pupil's centre shows a pixel of the view that
+  // `view_mask` (row-major, the view's size) marks, through the scene's surface when given, else
+  // where it meets the flat screen: a region of the scene (its plane) as the eye sees it.
+  std::vector<std::uint8_t> view_region_mask(const EyeModel& eye, const std::vector<std::uint8_t>& view_mask,
+                                             const SceneDepth* scene = nullptr) const;
   // The retina at the listed pixels (column, row) of the field only, traced as retina() traces them:
   // for measurements that look at a few spots of the field with many pupil samples.
   std::vector<Rgba> retina_at(const Image& displayed, const EyeModel& eye,
@@ -116,6 +135,7 @@ class EyeSimulator {
   DeviceOptics device_;
   double render_distance_mm_;
   Vec2 screen_centre_mm_, screen_size_mm_;
+  int view_width_ = 0, view_height_ = 0;
   Image band_limited_view_;
   VisualField field_;
   std::vector<double> tan_x_, tan_y_;  // direction tangents per column / row: no trigonometry per ray

@@ -1,7 +1,9 @@
 // `nelf simulate`: what an eye sees on the display (DESIGN.md §5). Composites a still for one eye,
 // traces a thin-lens eye through the lens array onto it, and compares with the same eye looking at
-// the emulated screen: retinal image, ideal image, PSNR, and optionally a PSNR sweep over screen
-// distance × accommodation (the analogue of Lanman & Luebke's Fig. 11).
+// the emulated screen, or with the real scene when the source knows its depth (issue #15): retinal
+// image, ideal image, PSNR (per region of known depth too), and optionally a PSNR sweep over screen
+// distance × accommodation (the analogue of Lanman & Luebke's Fig. 11) and a focus sweep that finds
+// where the eye focuses best on each region.
 #include <fmt/format.h>
 #include <unistd.h>
 #include <charconv>
@@ -15,14 +17,17 @@
 #include <fmt/ranges.h>
 #include "analysis/defect_visibility.hpp"
 #include "analysis/eye_simulator.hpp"
+#include "analysis/focus_sweep.hpp"
 #include "app/commands.hpp"
 #include "app/heatmap.hpp"
 #include "compositor/make_compositor.hpp"
 #include "compositor/reference.hpp"
 #include "core/printable.hpp"
 #include "hmz_output/image_sink.hpp"
+#include "inputs/stereo_matcher.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/synthetic_source.hpp"
+#include "inputs/view_bytes.hpp"
 #include "optics/defect_compensation.hpp"
 #include "optics/mapping.hpp"
 #include "player/input_files.hpp"
@@ -34,9 +39,12 @@ namespace {
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
 // The compositing step: what the display shows for `eye`, rendered the way `nelf convert` renders it
-// (the GL compositor at the default antialiasing).
-Image composite_eye_image(const Profile& profile, Eye eye, const View& view) {
-  EyeImages eyes = make_compositor(profile, CompositorOptions{})->compose({view, view});
+// (the GL compositor at the default antialiasing), with the content's depth when given.
+Image composite_eye_image(const Profile& profile, Eye eye, const View& view,
+                          std::shared_ptr<const DisparitySurface> depth = nullptr) {
+  const auto compositor = make_compositor(profile, CompositorOptions{});
+  compositor->set_depth(eye, std::move(depth));
+  EyeImages eyes = compositor->compose({view, view});
   return std::move(eyes[static_cast<int>(eye)]);
 }
 
@@ -50,6 +58,9 @@ struct SimulateArgs {
   std::string output;
   std::string ideal;
   std::string sweep;
+  std::string focus_sweep;
+  std::string depth = "off";
+  std::string reference = "auto";
   bool json = false;
   bool no_defect_compensation = false;
   std::string layout = "auto";
@@ -107,6 +118,73 @@ std::string distance_label(double mm) {
   return mm >= 1000.0 ? fmt::format("{:g} m", mm / 1000.0) : fmt::format("{:.0f} mm", mm);
 }
 
+// The input as simulate sees it: this eye's view, both views (what depth is estimated from), and
+// what the source knows of its scene (the synthetic scenes' exact depth and regions).
+struct SimulatedInput {
+  StereoPair pair;
+  std::shared_ptr<const StereoDisparity> known_depth;
+  std::vector<SceneRegion> regions;
+  std::string warning;
+  const View& view(Eye eye) const { return eye == Eye::left ? pair.left : pair.right; }
+};
+
+SimulatedInput load_simulated_input(const SimulateArgs& args, const StillOptions& still, const Profile& profile) {
+  SimulatedInput in;
+  if (is_synthetic_spec(args.input)) {
+    // The built-in clip's first frame, filmed for this display's emulated screen so that the depth
+    // it knows is the depth the eye sees: lets the demo show what the eye sees without any media file.
+    try {
+      const SyntheticClip clip(matched_to_display(parse_synthetic_spec(args.input), profile));
+      in.pair = clip.render(0);
+      in.known_depth = clip.disparity(0);
+      in.regions = clip.regions(0);
+    } catch (const std::invalid_argument& e) {
+      throw UserError(e.what(), 2);
+    }
+    return in;
+  }
+  try {
+    StillStereo stereo = load_still(args.input, still);
+    in.warning = stereo.decision.warning;
+    in.pair = std::move(stereo.views);
+  } catch (const StillError& e) {
+    throw UserError(e.what());
+  }
+  return in;
+}
+
+// Both views' disparity estimated as `nelf play --depth estimate` estimates a frame's (16-bit views,
+// so the still's precision is kept); null when the pair cannot be matched.
+std::shared_ptr<const StereoDisparity> estimate_depth(const StereoPair& pair) {
+  const Image& l = pair.left.image;
+  const Image& r = pair.right.image;
+  if (l.width() != r.width() || l.height() != r.height()) return nullptr;
+  StereoVideoFrame frame;
+  frame.width = l.width();
+  frame.height = l.height();
+  frame.bits = 16;
+  frame.left = view_bytes(l, 16);
+  frame.right = view_bytes(r, 16);
+  frame.aspect = pair.left.aspect();
+  return StereoMatcher().estimate(frame);
+}
+
+// A sweep's heatmap (beside the table, as .png) and then its table: a failure leaves neither
+// half-written.
+void write_sweep(const Heatmap& map, const std::string& csv, const std::filesystem::path& csv_path, const char* what) {
+  write_heatmap_png(map, std::filesystem::path(csv_path).replace_extension(".png"));
+  try {
+    write_file_atomically(csv_path, true, [&](const std::filesystem::path& temporary) {
+      std::ofstream out(temporary, std::ios::binary);
+      out << csv;
+      out.close();
+      if (!out) throw UserError(fmt::format("cannot write {} '{}'", what, csv_path.string()));
+    });
+  } catch (const ImageWriteError& e) {
+    throw UserError(e.what());
+  }
+}
+
 // PSNR over screen distance × accommodation, both in diopters (0 D = infinity for accommodation).
 // Affordable on two cores: 1.5 retinal samples per display footprint and 5×5 pupil samples (the single
 // simulation uses 3 and 7×7); each screen distance is composited once.
@@ -148,42 +226,66 @@ void run_sweep(const SimulateArgs& args, const Profile& profile, Eye eye, const 
     }
   }
 
-  // The heatmap first, then the table: a failure leaves neither half-written.
-  write_heatmap_png(map, std::filesystem::path(csv_path).replace_extension(".png"));
-  try {
-    write_file_atomically(csv_path, true, [&](const std::filesystem::path& temporary) {
-      std::ofstream out(temporary, std::ios::binary);
-      out << csv;
-      out.close();
-      if (!out) throw UserError(fmt::format("cannot write sweep '{}'", csv_path.string()));
-    });
-  } catch (const ImageWriteError& e) {
-    throw UserError(e.what());
+  write_sweep(map, csv, csv_path, "sweep");
+}
+
+// The focus sweep as a table (one row per accommodation and region) and a heatmap beside it (one
+// row per region).
+void write_focus_sweep(const FocusSweep& focus, const SimulateArgs& args, const Profile& profile, double pupil_mm,
+                       bool scene_reference, const std::filesystem::path& csv_path) {
+  Heatmap map;
+  map.title = fmt::format("PSNR of the {} eye vs. the all-in-focus {}: {}, depth {}, pupil {:g} mm", args.eye,
+                          scene_reference ? "scene" : "screen", profile.name, args.depth, pupil_mm);
+  map.x_label = "accommodation (diopters, 0 = infinity)";
+  map.y_label = "region (its depth)";
+  map.value_label = "PSNR dB";
+  for (double a : focus.accommodation_diopters) map.x_ticks.push_back(fmt::format("{:g}", a));
+  std::string csv = "region,depth_mm,accommodation_diopters,accommodation_mm,psnr_db\n";
+  for (const FocusCurve& c : focus.regions) {
+    map.y_ticks.push_back(std::isfinite(c.depth_mm) ? fmt::format("{} ({:.2f} D; best {:.2f} D)", c.name,
+                                                                  1000.0 / c.depth_mm, c.best_focus_diopters)
+                                                    : fmt::format("{} (best {:.2f} D)", c.name, c.best_focus_diopters));
+    map.values.push_back(c.psnr_db);
+    for (std::size_t k = 0; k < focus.accommodation_diopters.size(); ++k) {
+      const double a = focus.accommodation_diopters[k];
+      csv += fmt::format("{},{},{:g},{},{:.3f}\n", c.name,
+                         std::isfinite(c.depth_mm) ? fmt::format("{:.1f}", c.depth_mm) : std::string(), a,
+                         a > 0.0 ? fmt::format("{:.1f}", 1000.0 / a) : std::string("inf"), c.psnr_db[k]);
+    }
   }
+  write_sweep(map, csv, csv_path, "focus sweep");
 }
 
 void run_simulate(const SimulateArgs& args) {
   // Arguments first: a typo should not cost a compositing pass.
   const Eye eye = args.eye == "right" ? Eye::right : Eye::left;
+  const std::optional<DepthMode> parsed_depth = parse_depth_mode(args.depth);
+  if (!parsed_depth)
+    throw UserError(fmt::format("--depth must be one of {}, got '{}'", fmt::join(depth_mode_names(), ", "), args.depth),
+                    2);
+  const DepthMode depth_mode = *parsed_depth;
+  const std::string& reference = args.reference;
   EyeModel eye_model;
   eye_model.offset_mm = parse_eye_offset(args.eye_offset);
   std::optional<double> focus_mm;
   if (args.focus) focus_mm = parse_focus_mm(*args.focus);
   if (args.pupil_mm && !(*args.pupil_mm > 0.0))
     throw UserError(fmt::format("--pupil-mm must be > 0, got {}", *args.pupil_mm), 2);
-  if (!args.sweep.empty() && std::filesystem::path(args.sweep).extension() == ".png")
-    throw UserError(fmt::format("--sweep '{}' is the CSV table; the heatmap goes beside it as .png", args.sweep), 2);
+  for (const auto& [option, path] : {std::pair{"--sweep", &args.sweep}, std::pair{"--focus-sweep", &args.focus_sweep}})
+    if (!path->empty() && std::filesystem::path(*path).extension() == ".png")
+      throw UserError(fmt::format("{} '{}' is the CSV table; the heatmap goes beside it as .png", option, *path), 2);
   InputFiles inputs;
   inputs.add(args.input, "the input");
   inputs.add(args.right, "the --right view");
   inputs.add(args.profile, "the --profile");
-  for (const std::string& output : {args.output, args.ideal, args.sweep})
+  for (const std::string& output : {args.output, args.ideal, args.sweep, args.focus_sweep})
     if (!output.empty()) inputs.refuse_as_output(output);
-  if (!args.sweep.empty())
-    inputs.refuse_as_output(std::filesystem::path(args.sweep).replace_extension(".png").string());
+  for (const std::string& table : {args.sweep, args.focus_sweep})
+    if (!table.empty()) inputs.refuse_as_output(std::filesystem::path(table).replace_extension(".png").string());
   check_writable(args.output, "--output");
   check_writable(args.ideal, "--ideal");
   check_writable(args.sweep, "--sweep");
+  check_writable(args.focus_sweep, "--focus-sweep");
   StillOptions still;
   still.layout = parse_layout_option(args.layout);
   if (!args.right.empty()) still.right = args.right;
@@ -202,33 +304,50 @@ void run_simulate(const SimulateArgs& args) {
   eye_model.focus_mm = focus_mm.value_or(render_distance_mm(profile));
 
   // The source's view for this eye (a stereo still in any layout; a 2D image is the view of both).
-  View view;
-  if (is_synthetic_spec(args.input)) {
-    // The built-in clip's first frame: lets the demo show what the eye sees without any media file.
-    try {
-      StereoPair pair = SyntheticClip(parse_synthetic_spec(args.input)).render(0);
-      view = eye == Eye::left ? std::move(pair.left) : std::move(pair.right);
-    } catch (const std::invalid_argument& e) {
-      throw UserError(e.what(), 2);
-    }
-  } else {
-    try {
-      StillStereo stereo = load_still(args.input, still);
-      if (!stereo.decision.warning.empty() && !args.json)
-        fmt::print(stderr, "nelf: warning: {}\n", printable(stereo.decision.warning));
-      view = eye == Eye::left ? std::move(stereo.views.left) : std::move(stereo.views.right);
-    } catch (const StillError& e) {
-      throw UserError(e.what());
+  const SimulatedInput input = load_simulated_input(args, still, profile);
+  if (!input.warning.empty() && !args.json) fmt::print(stderr, "nelf: warning: {}\n", printable(input.warning));
+  const View& view = input.view(eye);
+  const EyeMapping rendering = make_eye_mapping(profile, eye, view.aspect());
+  const DepthGeometry geometry = depth_geometry(profile, rendering);
+  const auto eye_surface = [&](const std::shared_ptr<const StereoDisparity>& d) {
+    return d ? std::make_shared<const DisparitySurface>(eye == Eye::left ? d->left : d->right) : nullptr;
+  };
+
+  // The depth the composite follows (--depth): the source's own where it knows it (auto), else the
+  // stereo matcher's estimate; none leaves everything on the flat screen.
+  std::shared_ptr<const StereoDisparity> composite_depth;
+  std::string depth_used = "none";
+  if (depth_mode != DepthMode::off) {
+    if (depth_mode == DepthMode::automatic && input.known_depth) {
+      composite_depth = input.known_depth;
+      depth_used = "known";
+    } else {
+      composite_depth = estimate_depth(input.pair);
+      if (composite_depth)
+        depth_used = "estimated";
+      else if (!args.json)
+        fmt::print(stderr,
+                   "nelf: depth: the stereo pair cannot be matched (too little texture); simulating the flat "
+                   "screen\n");
     }
   }
-  const EyeMapping rendering = make_eye_mapping(profile, eye, view.aspect());
+  // What the retina is compared with (--reference): the real scene where the source knows it.
+  const bool scene_reference = reference == "scene" || (reference == "auto" && input.known_depth);
+  if (scene_reference && !input.known_depth)
+    throw UserError(
+        "--reference scene needs an input that knows its depth (synthetic:, e.g. synthetic:scene=planes); use "
+        "--reference screen",
+        2);
+  const std::optional<SceneDepth> scene =
+      scene_reference ? std::optional<SceneDepth>(SceneDepth{eye_surface(input.known_depth), geometry}) : std::nullopt;
+  const SceneDepth* scene_ptr = scene ? &*scene : nullptr;
   // The defect-free display: the map is taken out of the profile here, so that the defects (and their
   // compensation) are applied once, below, whatever the compositor does with a map.
   Profile without_defects = profile;
   without_defects.correction.defects.reset();
   without_defects.correction.defect_map.clear();
   without_defects.correction.defect_map_path.clear();
-  const Image clean = composite_eye_image(without_defects, eye, view);
+  const Image clean = composite_eye_image(without_defects, eye, view, eye_surface(composite_depth));
   const EyeSimulator simulator(device, rendering, view.image);
 
   // A panel with a defect map shows its defects, compensated unless asked not to; the retina and the
@@ -244,9 +363,47 @@ void run_simulate(const SimulateArgs& args) {
     if (!args.no_defect_compensation) compensated = defective_display(*defects, eye, compensated_display(*plan, clean));
   }
   const Image& displayed = !defects ? clean : args.no_defect_compensation ? uncompensated : compensated;
-  const SimulationResult result = simulator.simulate(displayed, eye_model);
+  const SimulationResult result = simulator.simulate(displayed, eye_model, scene_ptr);
+
+  // The regions of known depth as the retina sees them, each judged on its own.
+  const auto retinal_regions = [&](const EyeSimulator& sim, const EyeModel& e) {
+    std::vector<RetinalRegion> out;
+    for (const SceneRegion& r : input.regions)
+      out.push_back(
+          {r.name, r.depth_mm, sim.view_region_mask(e, eye == Eye::left ? r.left_mask : r.right_mask, scene_ptr)});
+    return out;
+  };
+  struct RegionResult {
+    std::string name;
+    double depth_mm;
+    double psnr_db;
+  };
+  std::vector<RegionResult> region_results;
+  for (RetinalRegion& r : retinal_regions(simulator, eye_model)) {
+    std::size_t count = 0;
+    for (std::size_t k = 0; k < r.mask.size(); ++k) count += r.mask[k] = r.mask[k] && result.evaluated[k] ? 1 : 0;
+    region_results.push_back({r.name, r.depth_mm, count ? psnr_db(result.retina, result.ideal, r.mask) : std::nan("")});
+  }
+
+  // Where the eye focuses best on each region (the whole clear field for inputs without regions).
+  std::optional<FocusSweep> focus;
+  if (!args.focus_sweep.empty()) {
+    SimulatorOptions options;
+    options.samples_per_footprint = 1.5;  // as --sweep: 19 retinas in seconds, not minutes
+    const EyeSimulator sweep_simulator(device, rendering, view.image, options);
+    EyeModel sweep_eye = eye_model;
+    sweep_eye.pupil_samples_per_axis = 5;
+    std::vector<RetinalRegion> regions = retinal_regions(sweep_simulator, sweep_eye);
+    if (regions.empty()) regions.push_back({"all", std::nan(""), sweep_simulator.on_screen_mask(sweep_eye)});
+    try {
+      focus = sweep_focus(sweep_simulator, displayed, sweep_eye, scene_ptr, regions, accommodation_steps(4.5, 0.25));
+    } catch (const std::invalid_argument& e) {
+      throw UserError(fmt::format("--focus-sweep: {}", e.what()));
+    }
+  }
 
   if (!args.sweep.empty()) run_sweep(args, profile, eye, view, eye_model, args.sweep);
+  if (focus) write_focus_sweep(*focus, args, profile, eye_model.pupil_mm, scene_reference, args.focus_sweep);
   try {
     write_image_file(result.retina, args.output, {true, 8});
     if (!args.ideal.empty()) write_image_file(result.ideal, args.ideal, {true, 8});
@@ -308,6 +465,22 @@ void run_simulate(const SimulateArgs& args) {
     j["psnr_full_screen_db"] = finite_or_null(result.psnr_full_screen_db);
     j["evaluated_fraction"] = result.evaluated_fraction;
     j["retina_size"] = {result.retina.width(), result.retina.height()};
+    j["depth"] = depth_mode_name(depth_mode);
+    j["depth_used"] = depth_used;  // none, known or estimated
+    j["reference"] = scene_reference ? "scene" : "screen";
+    if (!region_results.empty()) {
+      j["regions"] = nlohmann::json::array();
+      for (const RegionResult& r : region_results)
+        j["regions"].push_back({{"name", r.name}, {"depth_mm", r.depth_mm}, {"psnr_db", finite_or_null(r.psnr_db)}});
+    }
+    if (focus) {
+      j["focus_sweep"] = nlohmann::json::array();
+      for (const FocusCurve& c : focus->regions)
+        j["focus_sweep"].push_back({{"name", c.name},
+                                    {"depth_mm", finite_or_null(c.depth_mm)},
+                                    {"depth_diopters", finite_or_null(1000.0 / c.depth_mm)},
+                                    {"best_focus_diopters", c.best_focus_diopters}});
+    }
     if (defects) j["defects"] = defect_json;
     fmt::print("{}\n", j.dump());
   } else {
@@ -317,6 +490,18 @@ void run_simulate(const SimulateArgs& args) {
         result.psnr_db, args.eye, distance_label(eye_model.focus_mm), eye_model.pupil_mm, eye_model.offset_mm.x,
         eye_model.offset_mm.y, 100 * result.evaluated_fraction, result.psnr_full_screen_db);
     if (defects) fmt::print("{}\n", defect_line);
+    fmt::print("against the {}; depth {}{}\n", scene_reference ? "real scene" : "emulated screen",
+               depth_mode_name(depth_mode),
+               depth_mode == DepthMode::off ? ""
+               : depth_used == "none"       ? " (none to be had: the flat screen)"
+                                            : fmt::format(" ({})", depth_used));
+    for (const RegionResult& r : region_results)
+      fmt::print("region {} at {}: PSNR {:.2f} dB\n", r.name, distance_label(r.depth_mm), r.psnr_db);
+    if (focus)
+      for (const FocusCurve& c : focus->regions)
+        fmt::print("best focus on {}{}: {:.2f} D\n", c.name,
+                   std::isfinite(c.depth_mm) ? fmt::format(" ({:.2f} D away)", 1000.0 / c.depth_mm) : "",
+                   c.best_focus_diopters);
   }
 }
 
@@ -348,6 +533,21 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--ideal", args->ideal, "Also write the ideal image (the eye looking at the screen)");
   cmd->add_flag("--no-defect-compensation", args->no_defect_compensation,
                 "Show the profile's defect map uncompensated (the defects' figures then lack the comparison)");
+  cmd->add_option("--depth", args->depth,
+                  "Composite with the content's depth: off (everything on the flat emulated screen), auto (the depth "
+                  "the input knows, as the synthetic scenes do, else estimated from the stereo pair), estimate "
+                  "(always estimated from the two views)")
+      ->check(CLI::IsMember(depth_mode_names()))
+      ->capture_default_str();
+  cmd->add_option("--reference", args->reference,
+                  "What the retina is compared with: the real scene (the planes at their depths; inputs that know "
+                  "their depth only), the emulated screen, or auto (the scene where known)")
+      ->check(CLI::IsMember({"auto", "screen", "scene"}))
+      ->capture_default_str();
+  cmd->add_option("--focus-sweep", args->focus_sweep,
+                  "Also sweep the accommodation 0-4.5 D in 0.25 D steps and tabulate each region's PSNR against the "
+                  "all-in-focus reference into this CSV, with a heatmap beside it (.png); prints where each region "
+                  "is in best focus");
   cmd->add_flag("--json", args->json, "Print one JSON object: psnr_db, focus_mm (null = infinity), pupil_mm, ...");
   cmd->add_option("--sweep", args->sweep,
                   "Also tabulate PSNR over screen distance (0.25-4 D) x accommodation (0-4 D) into this CSV and draw "

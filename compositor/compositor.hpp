@@ -2,6 +2,7 @@
 // The compositor stage: a stereo pair of views in, one image per eye at panel resolution out
 // (DESIGN.md §3–4). Implementations: the OpenGL path (gl_compositor) and the CPU reference.
 #include <array>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -11,6 +12,8 @@
 #include "optics/profile.hpp"
 
 namespace nelf {
+
+class DisparitySurface;  // optics/depth.hpp
 
 // Where the content's depth comes from (`--depth`): off, the flat emulated screen for everything;
 // auto, the depth a frame carries (StereoVideoFrame::disparity: a synthetic scene's exact depth),
@@ -45,6 +48,10 @@ class Compositor {
   virtual ~Compositor() = default;
   // Renders both eyes' images for `views`. Each view's display_aspect sets the screen's aspect.
   virtual EyeImages compose(const StereoPair& views) = 0;
+  // The content's depth for `eye`'s next compose() calls: each display pixel then shows the view
+  // where its ray meets that surface rather than the flat screen (optics/depth.hpp). Null: the flat
+  // screen. Stock profiles (no lenslets) keep the flat view.
+  virtual void set_depth(Eye eye, std::shared_ptr<const DisparitySurface> surface) = 0;
 };
 
 }  // namespace nelf

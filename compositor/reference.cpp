@@ -112,8 +112,12 @@ EyeImages ReferenceCompositor::compose(const StereoPair& views) {
   EyeImages eyes;
   for (Eye eye : {Eye::left, Eye::right}) {
     const View& v = eye == Eye::left ? views.left : views.right;
+    const EyeMapping mapping = make_eye_mapping(profile_, eye, v.aspect());
+    const auto& surface = surfaces_[static_cast<int>(eye)];
     eyes[static_cast<int>(eye)] =
-        reference_eye_image(make_eye_mapping(profile_, eye, v.aspect()), v.image, subsamples_);
+        surface && profile_.lens_array
+            ? reference_eye_image(mapping, v.image, *surface, depth_geometry(profile_, mapping), subsamples_)
+            : reference_eye_image(mapping, v.image, subsamples_);
   }
   return eyes;
 }

@@ -3,6 +3,9 @@
 // N×N stratified sub-samples over each display pixel's aperture (each sub-sample uses the lens that
 // owns its position), each a bilinear tap on the full-resolution view. Slow by design; it is the
 // oracle the GL path is tested against.
+#include <array>
+#include <memory>
+
 #include "compositor/compositor.hpp"
 #include "optics/depth.hpp"
 #include "optics/mapping.hpp"
@@ -26,10 +29,14 @@ class ReferenceCompositor final : public Compositor {
   explicit ReferenceCompositor(Profile profile, int subsamples = 16)
       : profile_(std::move(profile)), subsamples_(subsamples) {}
   EyeImages compose(const StereoPair& views) override;
+  void set_depth(Eye eye, std::shared_ptr<const DisparitySurface> surface) override {
+    surfaces_[static_cast<int>(eye)] = std::move(surface);
+  }
 
  private:
   Profile profile_;
   int subsamples_;
+  std::array<std::shared_ptr<const DisparitySurface>, 2> surfaces_;
 };
 
 }  // namespace nelf

@@ -102,7 +102,7 @@ class GlCompositor final : public Compositor {
   // chief ray (and, in the border strips, each part's ray) meets the content's surface rather than
   // the flat screen (optics/depth.hpp). Null: the flat screen. A flat (all-zero) surface renders what
   // no surface does. Stock profiles (no lenslets) keep the flat view.
-  void set_depth(Eye eye, std::shared_ptr<const DisparitySurface> surface);
+  void set_depth(Eye eye, std::shared_ptr<const DisparitySurface> surface) override;
 
   // Renders `eye` from `view` into `target` (panel-sized region). Prefilters the view first
   // (fsaa ≥ 1): call once per eye per frame. Leaves the target framebuffer bound.
