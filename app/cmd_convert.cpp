@@ -20,6 +20,7 @@
 #include "hmz_output/signal.hpp"
 #include "inputs/source_drivers.hpp"
 #include "inputs/stereo_layout.hpp"
+#include "inputs/stereo_matcher.hpp"
 #include "inputs/video_source.hpp"
 #include "optics/profile.hpp"
 #include "player/convert_video.hpp"
@@ -209,7 +210,9 @@ Signal resolve_signal(const Profile& profile, const std::string& name) {
 Image packed_still(const StereoPair& views, const Profile& profile, const Signal& signal,
                    const CompositorOptions& options) {
   FrameCompositor compositor(profile, options, packed_layout(signal, profile.display.resolution));
-  return compositor.render_still(views);
+  // A still knows no depth of its own: --depth auto and estimate both estimate it from its views.
+  const bool with_depth = options.depth != DepthMode::off && profile.lens_array;
+  return compositor.render_still(views, with_depth ? estimate_still_disparity(views) : nullptr);
 }
 
 void write_packed_still(const StereoPair& views, const Profile& profile, const Signal& signal,
@@ -248,6 +251,7 @@ CommonOptions parse_common_options(const CommonArgs& args, bool still) {
     throw UserError(e.what(), 2);
   }
   common.compositor.fsaa = args.fsaa;
+  common.compositor.depth = parse_depth_option(args.depth);
   common.compositor.gpu = args.gpu;
   common.compositor.defect_compensation = !args.no_defect_compensation;
 
@@ -282,8 +286,24 @@ void add_common_options(CLI::App& cmd, CommonArgs& args) {
                  "EGL device index to render on (default: NELF_GPU, else the first GPU, else software)");
   cmd.add_flag("--allow-network", args.allow_network,
                "Let FFmpeg use network protocols (default: files and pipes only)");
+  add_depth_option(cmd, args.depth);
   add_defect_compensation_option(cmd, args.no_defect_compensation);
   add_max_pixels_option(cmd, args.max_pixels);
+}
+
+void add_depth_option(CLI::App& cmd, std::string& depth) {
+  cmd.add_option("--depth", depth,
+                 "Composite with the content's depth: off (everything on the flat emulated screen), auto (the depth "
+                 "the input knows, as the synthetic scenes do, else estimated from the two views), estimate (always "
+                 "estimated from the two views)")
+      ->capture_default_str();
+}
+
+DepthMode parse_depth_option(const std::string& depth) {
+  const std::optional<DepthMode> mode = parse_depth_mode(depth);
+  if (!mode)
+    throw UserError(fmt::format("--depth must be one of {}, got '{}'", fmt::join(depth_mode_names(), ", "), depth), 2);
+  return *mode;
 }
 
 void add_defect_compensation_option(CLI::App& cmd, bool& no_defect_compensation) {

@@ -13,6 +13,7 @@
 #include "inputs/source_drivers.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/video_source.hpp"
+#include "player/depth_input.hpp"
 #include "player/interrupt.hpp"
 #include "player/live_display.hpp"
 #include "player/player.hpp"
@@ -52,7 +53,7 @@ void run_play(const PlayArgs& args) {
   request.quiet = args.quiet;
   request.allow_network = args.allow_network;
   request.max_pixels = args.max_pixels;
-  const auto source = open_source(request);
+  const auto source = open_source_for_depth(request, common.compositor.depth, common.profile);
 
   PlayerOptions options;
   options.profile = common.profile;

@@ -27,7 +27,6 @@
 #include "inputs/stereo_matcher.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/synthetic_source.hpp"
-#include "inputs/view_bytes.hpp"
 #include "optics/defect_compensation.hpp"
 #include "optics/mapping.hpp"
 #include "player/input_files.hpp"
@@ -153,22 +152,6 @@ SimulatedInput load_simulated_input(const SimulateArgs& args, const StillOptions
   return in;
 }
 
-// Both views' disparity estimated as `nelf play --depth estimate` estimates a frame's (16-bit views,
-// so the still's precision is kept); null when the pair cannot be matched.
-std::shared_ptr<const StereoDisparity> estimate_depth(const StereoPair& pair) {
-  const Image& l = pair.left.image;
-  const Image& r = pair.right.image;
-  if (l.width() != r.width() || l.height() != r.height()) return nullptr;
-  StereoVideoFrame frame;
-  frame.width = l.width();
-  frame.height = l.height();
-  frame.bits = 16;
-  frame.left = view_bytes(l, 16);
-  frame.right = view_bytes(r, 16);
-  frame.aspect = pair.left.aspect();
-  return StereoMatcher().estimate(frame);
-}
-
 // A sweep's heatmap (beside the table, as .png) and then its table: a failure leaves neither
 // half-written.
 void write_sweep(const Heatmap& map, const std::string& csv, const std::filesystem::path& csv_path, const char* what) {
@@ -259,11 +242,7 @@ void write_focus_sweep(const FocusSweep& focus, const SimulateArgs& args, const 
 void run_simulate(const SimulateArgs& args) {
   // Arguments first: a typo should not cost a compositing pass.
   const Eye eye = args.eye == "right" ? Eye::right : Eye::left;
-  const std::optional<DepthMode> parsed_depth = parse_depth_mode(args.depth);
-  if (!parsed_depth)
-    throw UserError(fmt::format("--depth must be one of {}, got '{}'", fmt::join(depth_mode_names(), ", "), args.depth),
-                    2);
-  const DepthMode depth_mode = *parsed_depth;
+  const DepthMode depth_mode = parse_depth_option(args.depth);
   const std::string& reference = args.reference;
   EyeModel eye_model;
   eye_model.offset_mm = parse_eye_offset(args.eye_offset);
@@ -322,7 +301,7 @@ void run_simulate(const SimulateArgs& args) {
       composite_depth = input.known_depth;
       depth_used = "known";
     } else {
-      composite_depth = estimate_depth(input.pair);
+      composite_depth = estimate_still_disparity(input.pair);
       if (composite_depth)
         depth_used = "estimated";
       else if (!args.json)
@@ -533,12 +512,7 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--ideal", args->ideal, "Also write the ideal image (the eye looking at the screen)");
   cmd->add_flag("--no-defect-compensation", args->no_defect_compensation,
                 "Show the profile's defect map uncompensated (the defects' figures then lack the comparison)");
-  cmd->add_option("--depth", args->depth,
-                  "Composite with the content's depth: off (everything on the flat emulated screen), auto (the depth "
-                  "the input knows, as the synthetic scenes do, else estimated from the stereo pair), estimate "
-                  "(always estimated from the two views)")
-      ->check(CLI::IsMember(depth_mode_names()))
-      ->capture_default_str();
+  add_depth_option(*cmd, args->depth);
   cmd->add_option("--reference", args->reference,
                   "What the retina is compared with: the real scene (the planes at their depths; inputs that know "
                   "their depth only), the emulated screen, or auto (the scene where known)")

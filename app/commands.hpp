@@ -32,6 +32,7 @@ struct CommonArgs {
   bool swap_eyes = false;
   std::string signal;  // empty = the profile's output.signal
   int fsaa = 1;
+  std::string depth = "off";  // --depth: off, auto or estimate
   std::optional<int> gpu;
   bool allow_network = false;
   std::int64_t max_pixels = kDefaultMaxPixels;
@@ -50,6 +51,10 @@ struct CommonOptions {
 void add_common_options(CLI::App& cmd, CommonArgs& args);
 // Registers --no-defect-compensation (shared by convert, play and calibrate: one wording).
 void add_defect_compensation_option(CLI::App& cmd, bool& no_defect_compensation);
+// Registers --depth (shared by convert, play and simulate: one wording), and the mode it names.
+// Throws UserError (status 2) naming the modes there are.
+void add_depth_option(CLI::App& cmd, std::string& depth);
+DepthMode parse_depth_option(const std::string& depth);
 // Registers --max-pixels (shared by convert, play, probe and simulate: one wording).
 void add_max_pixels_option(CLI::App& cmd, std::int64_t& max_pixels);
 // Throws UserError (status 2) for contradictory options and unknown signals, ProfileError for bad

@@ -420,8 +420,8 @@ void FrameCompositor::update_depth(const StereoVideoFrame& frame) {
   }
   if (!frame.disparity) {
     depth_notice(
-        "this source carries no depth (synthetic: scenes know theirs; estimating it from the two views is not "
-        "built in); showing the flat screen");
+        "a frame without depth (its two views cannot be matched: too little texture, or one view for both); such "
+        "frames show the flat screen");
     return;
   }
   if (frame.disparity != surfaces_from_) {
@@ -457,12 +457,15 @@ void FrameCompositor::composite_ahead(std::span<const Frame> frames, const Frame
   ahead_.want(ahead_setup(overlays, target.size), frames);
 }
 
-Image FrameCompositor::render_still(const StereoPair& views) {
-  if (options_.depth != DepthMode::off)
-    depth_notice(
-        "a still carries no depth (estimating it from the two views is not built in); showing the flat screen");
+Image FrameCompositor::render_still(const StereoPair& views, std::shared_ptr<const StereoDisparity> disparity) {
   start_gl();
+  StereoVideoFrame still;
+  still.disparity = std::move(disparity);
+  update_depth(still);
+  for (Eye eye : {Eye::left, Eye::right})
+    compositor_->set_depth(eye, depth_frame_ ? surfaces_[static_cast<int>(eye)] : nullptr);
   EyeImages eyes = compositor_->compose(views);
+  for (Eye eye : {Eye::left, Eye::right}) compositor_->set_depth(eye, nullptr);
   const EyeDefectPlans& plans = defect_plans({views.left.aspect(), views.right.aspect()}, false);
   for (std::size_t e = 0; e < 2; ++e)
     if (plans[e]) compensate_defects(*plans[e], eyes[e]);

@@ -139,7 +139,9 @@ class FrameCompositor {
   // A still: float views composited by GL (no composite tables: they replay 8-bit block means,
   // and stills keep 16-bit and float precision) and placed by the layout, cropped to the eye areas
   // as pack_eyes does. The views' own size and aspect; frames are not involved.
-  Image render_still(const StereoPair& views);
+  // With depth (options().depth, a lens-array profile), `disparity` is the still's: each pixel shows
+  // the view where its ray meets that surface; null, the flat screen (said once).
+  Image render_still(const StereoPair& views, std::shared_ptr<const StereoDisparity> disparity = nullptr);
 
  private:
   void start_gl();

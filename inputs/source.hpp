@@ -29,9 +29,13 @@ struct SourceRequest {
   bool quiet = false;                           // no line describing the input (warnings are printed all the same)
   bool allow_network = false;                   // FFmpeg protocols beyond file and pipe
   std::int64_t max_pixels = kDefaultMaxPixels;  // --max-pixels: larger frames are refused undecoded
-  // The display the frames are shown on, when known: a synthetic scene films itself for its
-  // emulated screen (matched_to_display), so that the depth it knows is the depth the viewer sees.
+  // The display the frames are shown on, where depth matters (`--depth` other than off): a
+  // synthetic scene films itself for its emulated screen (matched_to_display), so that the depth it
+  // has is the depth the viewer sees.
   std::shared_ptr<const Profile> display = nullptr;  // initialised: positional SourceRequest{…} may end before it
+  // Attach the depth the source knows to its frames (StereoVideoFrame::disparity: the synthetic
+  // scenes' exact depth), for `--depth auto`; sources that know none ignore it.
+  bool known_depth = false;
 };
 
 // What a source says about its stream once it is open.

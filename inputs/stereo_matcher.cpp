@@ -1,5 +1,7 @@
 #include "inputs/stereo_matcher.hpp"
 
+#include "inputs/view_bytes.hpp"
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -352,6 +354,20 @@ std::shared_ptr<const StereoDisparity> StereoMatcher::estimate(const StereoVideo
   result->left = upsample(left_d, left_gray, left_guide);
   result->right = upsample(right_d, right_gray, right_guide);
   return result;
+}
+
+std::shared_ptr<const StereoDisparity> estimate_still_disparity(const StereoPair& views) {
+  const Image& l = views.left.image;
+  const Image& r = views.right.image;
+  if (l.width() != r.width() || l.height() != r.height()) return nullptr;
+  StereoVideoFrame frame;
+  frame.width = l.width();
+  frame.height = l.height();
+  frame.bits = 16;
+  frame.left = view_bytes(l, 16);
+  frame.right = view_bytes(r, 16);
+  frame.aspect = views.left.aspect();
+  return StereoMatcher().estimate(frame);
 }
 
 }  // namespace nelf

@@ -52,4 +52,8 @@ class StereoMatcher {
   std::unique_ptr<State> state_;
 };
 
+// Both views' disparity of a still (16-bit views, so its precision is kept), as `estimate` gives a
+// frame's; null when the views differ in size or cannot be matched.
+std::shared_ptr<const StereoDisparity> estimate_still_disparity(const StereoPair& views);
+
 }  // namespace nelf

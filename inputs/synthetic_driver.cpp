@@ -1,4 +1,4 @@
-// The synthetic driver: `synthetic:[duration=S,fps=N,size=WxH]`, the built-in clip nelf renders
+// The synthetic driver: `synthetic:[scene=planes,duration=S,fps=N,size=WxH,…]`, the built-in clip nelf renders
 // itself (inputs/synthetic_source), delivered as whole views.
 #include <fmt/format.h>
 
@@ -17,11 +17,23 @@ namespace {
 
 class SyntheticFrameSource final : public Source {
  public:
-  SyntheticFrameSource(const std::string& spec, double start_s)
-      : clip_(parse_synthetic_spec(spec)), next_(static_cast<int>(std::lround(start_s * clip_.settings().fps))) {}
+  SyntheticFrameSource(SyntheticClipSettings settings, double start_s, bool known_depth)
+      : clip_(settings),
+        next_(static_cast<int>(std::lround(start_s * clip_.settings().fps))),
+        known_depth_(known_depth) {}
   std::optional<StereoVideoFrame> next() override {
     if (next_ >= clip_.frame_count()) return std::nullopt;
     const StereoPair pair = clip_.render(next_);
+    // The planes scene is still: one disparity for every frame (the compositor then makes its
+    // surfaces once); the spheres move, so theirs is traced per frame.
+    std::shared_ptr<const StereoDisparity> disparity;
+    if (known_depth_) {
+      if (clip_.settings().scene == SyntheticScene::spheres || !still_disparity_) disparity = clip_.disparity(next_);
+      if (clip_.settings().scene == SyntheticScene::planes) {
+        if (!still_disparity_) still_disparity_ = disparity;
+        disparity = still_disparity_;
+      }
+    }
     StereoVideoFrame f{pair.left.image.width(),
                        pair.left.image.height(),
                        8,
@@ -31,7 +43,7 @@ class SyntheticFrameSource final : public Source {
                        static_cast<double>(next_ - first_) / clip_.settings().fps,
                        {1, 1},
                        nullptr,
-                       nullptr};
+                       std::move(disparity)};
     ++next_;
     return f;
   }
@@ -58,6 +70,8 @@ class SyntheticFrameSource final : public Source {
   SyntheticClip clip_;
   int next_ = 0;
   int first_ = next_;
+  bool known_depth_ = false;
+  std::shared_ptr<const StereoDisparity> still_disparity_;
 };
 
 }  // namespace
@@ -66,7 +80,11 @@ bool accepts_synthetic(const SourceRequest& request) { return is_synthetic_spec(
 
 std::unique_ptr<Source> open_synthetic(const SourceRequest& request) {
   try {
-    return std::make_unique<SyntheticFrameSource>(request.input, request.start_s.value_or(0.0));
+    // Filmed for the display it is shown on when the request names one (depth matters), so that
+    // the depth of the scene is the depth the viewer sees (matched_to_display); else its own camera.
+    SyntheticClipSettings settings = parse_synthetic_spec(request.input);
+    if (request.display) settings = matched_to_display(settings, *request.display);
+    return std::make_unique<SyntheticFrameSource>(settings, request.start_s.value_or(0.0), request.known_depth);
   } catch (const std::invalid_argument& e) {
     throw UserError(e.what(), 2);
   }

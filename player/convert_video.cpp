@@ -28,6 +28,7 @@ extern "C" {
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
+#include "player/depth_input.hpp"
 #include "player/interrupt.hpp"
 #include "player/progress.hpp"
 
@@ -108,8 +109,9 @@ std::unique_ptr<FrameSink> open_frame_sink(const VideoConvertRequest& r, Source&
 
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
-  std::unique_ptr<Source> source = open_source(
-      SourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels, nullptr});
+  std::unique_ptr<Source> source = open_source_for_depth(
+      SourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels},
+      r.compositor.depth, r.profile);
   // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
   const ViewGeometry view = source->info().view;
   source->negotiate({stereo_prefilter_block(r.profile, r.compositor, view.width, view.height, view.aspect)});
