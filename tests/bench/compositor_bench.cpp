@@ -2,7 +2,9 @@
 // Not a test: run by hand, results go to docs/PERFORMANCE.md. Two figures per level:
 //   render    both eyes from textures already on the GPU into an FBO (the video path);
 //   compose   GlCompositor::compose(): upload both float views, render, read both eyes back.
-// Each is the median of several runs after a warm-up run, timed up to glFinish.
+// Each is the median of several runs after a warm-up run, timed up to glFinish. The last row is
+// the depth-aware pass (fsaa 1 with a disparity surface: a plane in front of a background behind
+// the screen, a 480×270 map), its ratio against fsaa 1 (issue #15 asks ≤ 1.5×).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,6 +18,7 @@
 
 #include "bench/bench_timing.hpp"
 #include "compositor/gl/gl_compositor.hpp"
+#include "optics/depth.hpp"
 
 namespace {
 
@@ -31,6 +34,15 @@ nelf::Image test_view(int width, int height) {
       image.at(x, y) = {v, static_cast<float>(u), static_cast<float>(t), 1.f};
     }
   return image;
+}
+
+// Disparity of a 480×270 map (view pixels of the map): a centred plane 12 px in front of a
+// background 4 px behind the screen (48 and 16 px of a 1920-wide view).
+nelf::ViewDisparity plane_in_front() {
+  nelf::ViewDisparity d{480, 270, std::vector<float>(480 * 270, -4.f)};
+  for (int y = 90; y < 180; ++y)
+    for (int x = 160; x < 320; ++x) d.d[static_cast<std::size_t>(y) * 480 + x] = 12.f;
+  return d;
 }
 
 }  // namespace
@@ -55,12 +67,15 @@ int main(int argc, char** argv) {
     std::printf("%-6s %12s %8s %14s %8s\n", "fsaa", "render ms", "ratio", "compose ms", "ratio");
     // The levels are interleaved run by run, so load from other processes on a shared machine
     // hits all of them alike; the first run of each (shader compilation, allocation) is dropped.
-    const int levels[] = {0, 1, 4, 16};
+    const int levels[] = {0, 1, 4, 16, 1};
+    const std::size_t depth_level = 4;
     std::vector<std::unique_ptr<nelf::GlCompositor>> compositors;
     for (int fsaa : levels)
       compositors.push_back(
           std::make_unique<nelf::GlCompositor>(profile, nelf::CompositorOptions{fsaa, std::nullopt}, context));
-    std::vector<std::vector<double>> render_ms(4), compose_ms(4);
+    const auto surface = std::make_shared<const nelf::DisparitySurface>(plane_in_front());
+    for (nelf::Eye eye : {nelf::Eye::left, nelf::Eye::right}) compositors[depth_level]->set_depth(eye, surface);
+    std::vector<std::vector<double>> render_ms(5), compose_ms(5);
     for (int run = 0; run <= runs; ++run) {
       for (std::size_t level = 0; level < compositors.size(); ++level) {
         nelf::GlCompositor& compositor = *compositors[level];
@@ -77,11 +92,14 @@ int main(int argc, char** argv) {
       }
     }
     const double render_base = median(render_ms[0]), compose_base = median(compose_ms[0]);
-    for (std::size_t level = 0; level < compositors.size(); ++level) {
+    for (std::size_t level = 0; level < depth_level; ++level) {
       const double render = median(render_ms[level]), compose = median(compose_ms[level]);
       std::printf("%-6d %12.1f %8.2f %14.1f %8.2f\n", levels[level], render, render / render_base, compose,
                   compose / compose_base);
     }
+    const double depth_render = median(render_ms[depth_level]), depth_compose = median(compose_ms[depth_level]);
+    std::printf("%-6s %12.1f %8.2f %14.1f %8.2f  (ratios against fsaa 1)\n", "1+dep", depth_render,
+                depth_render / median(render_ms[1]), depth_compose, depth_compose / median(compose_ms[1]));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "compositor_bench: %s\n", e.what());
     return 1;
