@@ -72,7 +72,11 @@ void write_heatmap_png(const Heatmap& map, const std::filesystem::path& path) {
   }
   if (!(lo < hi)) lo = std::isfinite(lo) ? lo - 1 : 0, hi = std::isfinite(hi) ? hi + 1 : 1;
 
-  constexpr int cell_w = 46, cell_h = 34, left = 130, top = 60, bottom = 80, bar_gap = 30, bar_w = 24, right = 90;
+  constexpr int cell_w = 46, cell_h = 34, top = 60, bottom = 80, bar_gap = 30, bar_w = 24, right = 90;
+  // Room for the longest row label at 14 px (about 8 px a character in DejaVu Sans), 130 px at least.
+  std::size_t longest = 0;
+  for (const std::string& tick : map.y_ticks) longest = std::max(longest, tick.size());
+  const int left = std::max(130, 16 + static_cast<int>(longest) * 8);
   const int plot_w = columns * cell_w, plot_h = rows * cell_h;
   Canvas canvas(left + plot_w + bar_gap + bar_w + right, top + plot_h + bottom);
 

@@ -263,12 +263,21 @@ TEST(DesignCli, ValidProfileFileWorks) {
 
 // --- the rest of the CLI surface -----------------------------------------------------------------
 
-TEST(ProfilesCli, ListsBothBuiltins) {
+TEST(ProfilesCli, ListsEachBuiltinWithItsDescriptionInAColumn) {
   const auto r = run_nelf("profiles");
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.out.find("hmz-t1 "), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("hmz-t1-stock"), std::string::npos) << r.out;
-  EXPECT_EQ(count_lines(r.out), 2u) << r.out;
+  EXPECT_EQ(count_lines(r.out), 4u) << r.out;
+  // Every description starts in the same column, past the longest name (ii-2160-testbed).
+  std::size_t column = 0;
+  for (const char* name : {"hmz-t1 ", "hmz-t1-stock ", "ii-2160-testbed ", "lvt-prototype "}) {
+    const auto at = r.out.find(name);
+    ASSERT_NE(at, std::string::npos) << name << "\n" << r.out;
+    const auto line_start = r.out.rfind('\n', at) == std::string::npos ? 0 : r.out.rfind('\n', at) + 1;
+    const auto description = r.out.find_first_not_of(' ', at + std::string(name).size() - 1) - line_start;
+    if (column == 0) column = description;
+    EXPECT_EQ(description, column) << name << "\n" << r.out;
+  }
+  EXPECT_EQ(column, std::string("ii-2160-testbed ").size());
 }
 
 TEST(Cli, Version) {
