@@ -3,31 +3,17 @@
 #include "analysis/defect_visibility.hpp"
 #include "optics/defect_compensation.hpp"
 #include "support/defect_maps.hpp"
+#include "support/test_support.hpp"
 
 namespace nelf {
 namespace {
 
-// The hmz-t1 optics on half the pixels at twice the pitch (as in test_eye_simulator.cpp): the same
-// lenses, eye box and beams, a quarter of the pixels.
-constexpr const char* small_profile_toml = R"(
-name = "small"
-[display]
-resolution = [640, 360]
-pixel_pitch_mm = 0.024
-[lens_array]
-pitch_mm = 1.0
-focal_length_mm = 3.3
-[viewing]
-eye_relief_mm = 25.0
-virtual_image_mm = 1000.0
-pupil_mm = 4.0
-ipd_mm = 63.0
-)";
+using test::half_resolution_hmz_toml;  // tests/support: the hmz-t1 optics on a quarter of its pixels
 
 // A mid-grey view shown on the small display: every lit pixel shows 0.5 (what any compositor makes
 // of a flat view away from the screen's edges).
 struct GreyScene {
-  Profile profile = parse_profile(small_profile_toml, "small.toml");
+  Profile profile = parse_profile(half_resolution_hmz_toml, "small.toml");
   EyeMapping rendering = make_eye_mapping(profile, Eye::left, 16.0 / 9.0);
   Image view = flat(64, 36, 0.5f);
   Image clean = grey_display();

@@ -5,29 +5,14 @@
 
 #include "analysis/eye_simulator.hpp"
 #include "compositor/reference.hpp"
+#include "support/test_support.hpp"
 
 namespace nelf {
 namespace {
 
-// The hmz-t1 optics (1.0 mm / f 3.3 mm sheet, 25 mm eye relief, image at 1 m) on half the pixels at twice
-// the pitch: the same lens block, field of view and eye box, a quarter of the pixels to composite and a
-// retinal grid of about 210×120, so the whole suite stays fast (also under ASan).
-constexpr const char* small_profile_toml = R"(
-name = "small"
-[display]
-resolution = [640, 360]
-pixel_pitch_mm = 0.024
-[lens_array]
-pitch_mm = 1.0
-focal_length_mm = 3.3
-[viewing]
-eye_relief_mm = 25.0
-virtual_image_mm = 1000.0
-pupil_mm = 4.0
-ipd_mm = 63.0
-)";
+using test::half_resolution_hmz_toml;  // tests/support: the hmz-t1 optics on a quarter of its pixels
 
-Profile small_profile() { return parse_profile(small_profile_toml, "small.toml"); }
+Profile small_profile() { return parse_profile(half_resolution_hmz_toml, "small.toml"); }
 
 // Content the display can resolve, with edges: blocks about eight display footprints wide, a colour
 // ramp and rings a few footprints apart.

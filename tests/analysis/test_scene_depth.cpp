@@ -9,25 +9,12 @@
 
 #include "analysis/eye_simulator.hpp"
 #include "compositor/reference.hpp"
+#include "support/test_support.hpp"
 
 namespace nelf {
 namespace {
 
-// The hmz-t1 optics on half the pixels at twice the pitch (as test_eye_simulator.cpp): fast.
-constexpr const char* small_profile_toml = R"(
-name = "small"
-[display]
-resolution = [640, 360]
-pixel_pitch_mm = 0.024
-[lens_array]
-pitch_mm = 1.0
-focal_length_mm = 3.3
-[viewing]
-eye_relief_mm = 25.0
-virtual_image_mm = 1000.0
-pupil_mm = 4.0
-ipd_mm = 63.0
-)";
+using test::half_resolution_hmz_toml;  // tests/support: the hmz-t1 optics on a quarter of its pixels
 
 // Fine detail a few display footprints across, so defocus shows.
 Image detailed_view(int width = 512, int height = 288) {
@@ -42,7 +29,7 @@ Image detailed_view(int width = 512, int height = 288) {
 }
 
 struct DepthScene {
-  Profile profile = parse_profile(small_profile_toml, "small.toml");
+  Profile profile = parse_profile(half_resolution_hmz_toml, "small.toml");
   Image view = detailed_view();
   EyeMapping rendering = make_eye_mapping(profile, Eye::left, 16.0 / 9.0);
   DepthGeometry geometry = depth_geometry(profile, rendering);

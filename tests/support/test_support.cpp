@@ -73,6 +73,21 @@ CommandResult run_command(const std::string& command_line) {
   return r;
 }
 
+const char* const half_resolution_hmz_toml = R"(
+name = "small"
+[display]
+resolution = [640, 360]
+pixel_pitch_mm = 0.024
+[lens_array]
+pitch_mm = 1.0
+focal_length_mm = 3.3
+[viewing]
+eye_relief_mm = 25.0
+virtual_image_mm = 1000.0
+pupil_mm = 4.0
+ipd_mm = 63.0
+)";
+
 std::filesystem::path write_small_profile(const TempDir& dir) {
   const auto path = dir / "small.toml";
   write_file(path, R"(name = "small"

@@ -65,6 +65,12 @@ class ScopedEnv {
 // Quotes a string for /bin/sh.
 std::string shell_quote(const std::string& s);
 
+// The hmz-t1 optics (1.0 mm / f 3.3 mm sheet, 25 mm eye relief, image at 1 m) on half the pixels per
+// axis at twice the pitch (640x360 at 24 um): the same lens block, field of view, eye box and beams,
+// a quarter of the pixels to composite and a retinal grid of about 210x120, so that the suites that
+// simulate the eye stay fast (also under ASan). A profile's TOML text, named "small".
+extern const char* const half_resolution_hmz_toml;
+
 // Writes `dir`/small.toml and returns its path: a light-field profile with a 160x90 panel (the
 // HMZ-T1's physical size) so that llvmpipe and the CPU reference composite in milliseconds. Its
 // signal is the HMZ-T1's (hdmi-fp-720p60): the panel sits centred in each 1280x720 eye area.
