@@ -283,14 +283,14 @@ std::shared_ptr<const StereoDisparity> StereoMatcher::estimate(const StereoVideo
     return std::max(1, static_cast<int>(std::lround(static_cast<double>(width) * gh / gw)));
   };
 
-  // The disparity range, from a wide search at a coarse resolution: from 1/6 of the width behind
+  // The disparity range, from a wide search at a coarse resolution: from 1/4 of the width behind
   // the screen to 1/2 in front.
   const int wp = std::min(probe_width, gw), hp = height_at(wp);
   const cv::Mat left_probe = area_resize(left_guide, wp, hp), right_probe = area_resize(right_guide, wp, hp);
   auto& bm = *s.bm;
   bm.setBlockSize(7);
   bm.setSpeckleWindowSize(wp * hp / 1000);
-  const int probe_min = -round_up_16(wp / 6);
+  const int probe_min = -round_up_16(wp / 4);
   const cv::Mat probe = block_match(bm, left_probe, right_probe, probe_min, round_up_16(wp / 2) - probe_min);
   std::vector<float> found;
   found.reserve(probe.total());

@@ -37,24 +37,27 @@ DisparitySurface::DisparitySurface(const ViewDisparity& disparity)
   for (int y = 0; y < height_; ++y) {
     const float* in = disparity.d.data() + static_cast<std::size_t>(y) * width_;
     float* out = values_.data() + static_cast<std::size_t>(y) * width_;
-    // Nearest known texel of the row: a left-to-right pass, then right-to-left for the texels
-    // nearer to a known one on their right.
-    std::vector<int> distance(static_cast<std::size_t>(width_), std::numeric_limits<int>::max());
-    int last = -1;
+    // An unknown run is what one view sees and the other does not (an occlusion beside a nearer
+    // surface, or the view's edge): it belongs to the farther of the known texels either side of it
+    // in the row (the smaller disparity), or to the one there is at the row's ends.
+    std::vector<float> before(static_cast<std::size_t>(width_), std::numeric_limits<float>::quiet_NaN());
+    float last = std::numeric_limits<float>::quiet_NaN();
     for (int x = 0; x < width_; ++x) {
-      if (std::isfinite(in[x])) last = x;
-      if (last >= 0) out[x] = in[last] * to_screen, distance[x] = x - last;
+      if (std::isfinite(in[x])) last = in[x];
+      before[static_cast<std::size_t>(x)] = last;
     }
-    last = -1;
+    last = std::numeric_limits<float>::quiet_NaN();
     for (int x = width_ - 1; x >= 0; --x) {
-      if (std::isfinite(in[x])) last = x;
-      if (last >= 0 && last - x < distance[x]) out[x] = in[last] * to_screen, distance[x] = last - x;
-    }
-    for (int x = 0; x < width_; ++x)
-      if (distance[x] == std::numeric_limits<int>::max())
-        out[x] = 0.f;
-      else
+      if (std::isfinite(in[x])) {
+        last = in[x];
+        out[x] = in[x] * to_screen;
         any = true;
+        continue;
+      }
+      const float left = before[static_cast<std::size_t>(x)];
+      const float farther = std::isnan(left) ? last : std::isnan(last) ? left : std::min(left, last);
+      out[x] = std::isnan(farther) ? 0.f : farther * to_screen;  // a row with nothing known: the screen
+    }
   }
   unknown_ = !any;
   const auto [lo, hi] = std::minmax_element(values_.begin(), values_.end());

@@ -38,8 +38,9 @@ double disparity_mm_from_depth(const DepthGeometry& g, double depth_mm);
 double depth_mm_from_disparity(const DepthGeometry& g, double disparity_mm);
 
 // A view's disparity as a surface the compositor searches: per map texel the disparity in units of
-// the screen's width (δ / W; what the shader's texture holds), unknown texels (NaN) filled from
-// the nearest known one of their row (a row with none: the screen, 0), and the range of the values.
+// the screen's width (δ / W; what the shader's texture holds), unknown texels (NaN: occluded in the
+// other view, or unmatched) filled with the farther of the known texels either side of them in
+// their row (a row with none: the screen, 0), and the range of the values.
 class DisparitySurface {
  public:
   // Throws std::invalid_argument for a map whose size does not match its values or is empty.

@@ -46,7 +46,16 @@ TEST(DepthGeometry, PupilGainMakesTheOtherEyeTheOtherView) {
   EXPECT_NEAR(up.y, -500.0 / 281.25, 1e-12);
 }
 
-TEST(DisparitySurface, ValuesAreFractionsOfTheWidthAndUnknownTexelsTakeTheNearestKnown) {
+TEST(DisparitySurface, UnknownTexelsBetweenTwoDepthsTakeTheFartherOne) {
+  // An occlusion beside a near surface (disparity 12) on a far one (-4): the band is the far
+  // surface, whichever side is nearer; at the ends of the row the one known value.
+  const float unknown = std::numeric_limits<float>::quiet_NaN();
+  const DisparitySurface s(ViewDisparity{8, 1, {unknown, -4.f, unknown, unknown, unknown, 12.f, unknown, unknown}});
+  const float expected[] = {-4, -4, -4, -4, -4, 12, 12, 12};
+  for (int x = 0; x < 8; ++x) EXPECT_FLOAT_EQ(s.values()[x] * 8, expected[x]) << x;
+}
+
+TEST(DisparitySurface, ValuesAreFractionsOfTheWidthAndUnknownTexelsTakeAKnownOne) {
   ViewDisparity d{4, 2, {nan, 8.f, nan, nan, nan, nan, nan, nan}};
   const DisparitySurface s(d);
   EXPECT_FALSE(s.unknown());
