@@ -33,6 +33,10 @@ done
 for doc in $(grep -o '](docs/[^)#]*' "$src/README.md" | sed 's/^](//' | sort -u); do
   grep -qx "/usr/share/doc/nelf/$doc" <<<"$contents" || fail "README links $doc, which is not installed"
 done
+# And every picture the docs show is installed beside them.
+for picture in $(cat "$src"/docs/*.md | grep -o '](pictures/[^)#]*' | sed 's/^](//' | sort -u); do
+  grep -qx "/usr/share/doc/nelf/docs/$picture" <<<"$contents" || fail "docs show $picture, which is not installed"
+done
 
 dpkg-deb -x "$deb" "$work/root"
 for elf in usr/bin/nelf usr/lib/nelf/nelf-oiio.so; do
