@@ -26,14 +26,8 @@ class SyntheticFrameSource final : public Source {
     const StereoPair pair = clip_.render(next_);
     // The planes scene is still: one disparity for every frame (the compositor then makes its
     // surfaces once); the spheres move, so theirs is traced per frame.
-    std::shared_ptr<const StereoDisparity> disparity;
-    if (known_depth_) {
-      if (clip_.settings().scene == SyntheticScene::spheres || !still_disparity_) disparity = clip_.disparity(next_);
-      if (clip_.settings().scene == SyntheticScene::planes) {
-        if (!still_disparity_) still_disparity_ = disparity;
-        disparity = still_disparity_;
-      }
-    }
+    if (known_depth_ && (clip_.settings().scene != SyntheticScene::planes || !disparity_))
+      disparity_ = clip_.disparity(next_);
     StereoVideoFrame f{pair.left.image.width(),
                        pair.left.image.height(),
                        8,
@@ -43,7 +37,7 @@ class SyntheticFrameSource final : public Source {
                        static_cast<double>(next_ - first_) / clip_.settings().fps,
                        {1, 1},
                        nullptr,
-                       std::move(disparity)};
+                       disparity_};
     ++next_;
     return f;
   }
@@ -71,7 +65,7 @@ class SyntheticFrameSource final : public Source {
   int next_ = 0;
   int first_ = next_;
   bool known_depth_ = false;
-  std::shared_ptr<const StereoDisparity> still_disparity_;
+  std::shared_ptr<const StereoDisparity> disparity_;  // the last frame's (known_depth_)
 };
 
 }  // namespace

@@ -30,7 +30,7 @@ double parse_number(const std::string& key, const std::string& value) {
 // A uniform number in [lo, hi) from the generator's raw output (portable, unlike std distributions).
 double uniform(std::mt19937& rng, double lo, double hi) { return lo + (hi - lo) * (rng() / 4294967296.0); }
 
-double parse_positive(const std::string& key, const std::string& value, double lo, double hi, const char* unit) {
+double parse_in_range(const std::string& key, const std::string& value, double lo, double hi, const char* unit) {
   const double v = parse_number(key, value);
   if (!(v >= lo && v <= hi))
     throw std::invalid_argument(fmt::format("synthetic: {} must be in [{}, {}] {}, got {}", key, lo, hi, unit, value));
@@ -111,17 +111,17 @@ SyntheticClipSettings parse_synthetic_spec(const std::string& spec) {
       else
         throw std::invalid_argument(fmt::format("synthetic: scene must be spheres or planes, got '{}'", value));
     } else if (key == "near") {
-      s.near_mm = parse_positive(key, value, 50, 100000, "mm");
+      s.near_mm = parse_in_range(key, value, 50, 100000, "mm");
     } else if (key == "far") {
-      s.far_mm = parse_positive(key, value, 50, 100000, "mm");
+      s.far_mm = parse_in_range(key, value, 50, 100000, "mm");
     } else if (key == "screen") {
-      s.screen_distance_mm = parse_positive(key, value, 50, 100000, "mm");
+      s.screen_distance_mm = parse_in_range(key, value, 50, 100000, "mm");
       s.camera_given = true;
     } else if (key == "ipd") {
-      s.ipd_mm = parse_positive(key, value, 1, 200, "mm");
+      s.ipd_mm = parse_in_range(key, value, 1, 200, "mm");
       s.camera_given = true;
     } else if (key == "fov") {
-      s.horizontal_fov_deg = parse_positive(key, value, 1, 170, "degrees");
+      s.horizontal_fov_deg = parse_in_range(key, value, 1, 170, "degrees");
       s.camera_given = true;
     } else {
       throw std::invalid_argument(

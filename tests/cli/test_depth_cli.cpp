@@ -47,14 +47,9 @@ int count_lines_with(const std::string& text, const std::string& what) {
 // A side-by-side photo whose right view is the left shifted 24 px to the left: a textured scene
 // (ffmpeg's testsrc2) uniformly in front of the screen, at about half its distance; or all black.
 std::filesystem::path stereo_photo(const TempDir& dir, bool black) {
-  const auto path = dir / (black ? "black.png" : "photo.png");
-  const std::string source = black ? "color=black:s=256x144" : "testsrc2=s=256x144";
-  const CommandResult r = run_command("ffmpeg -loglevel error -f lavfi -i " + source +
-                                      " -vf 'split[l][r];[r]crop=232:144:24:0,pad=256:144:0:0[s];[l][s]hstack' "
-                                      "-frames:v 1 " +
-                                      shell_quote(path.string()));
-  EXPECT_EQ(r.status, 0) << r.err;
-  return path;
+  return write_lavfi_still(dir, black ? "black.png" : "photo.png",
+                           black ? "color=black:s=256x144" : "testsrc2=s=256x144",
+                           "split[l][r];[r]crop=232:144:24:0,pad=256:144:0:0[s];[l][s]hstack");
 }
 
 TEST(DepthCli, ConvertCompositesASyntheticSceneWithItsDepth) {

@@ -68,11 +68,7 @@ TEST(SimulateDepthCli, FocusFollowsEachPlanesDepth) {
 
 TEST(SimulateDepthCli, AStillHasNoSceneToCompareWith) {
   TempDir dir;
-  const auto still = dir / "still.png";
-  ASSERT_EQ(
-      run_command("ffmpeg -loglevel error -f lavfi -i testsrc2=s=512x144 -frames:v 1 " + shell_quote(still.string()))
-          .status,
-      0);
+  const auto still = write_lavfi_still(dir, "still.png", "testsrc2=s=512x144");
   expect_clean_failure(dir,
                        "simulate " + shell_quote(still.string()) + " --layout sbs --reference scene -o " +
                            shell_quote((dir / "retina.png").string()),
@@ -82,11 +78,7 @@ TEST(SimulateDepthCli, AStillHasNoSceneToCompareWith) {
 TEST(SimulateDepthCli, ABlackPairCannotBeMatchedAndFallsBackToTheScreen) {
   // No texture, no disparity: the flat screen, said once, never garbage.
   TempDir dir;
-  const auto still = dir / "black.png";
-  ASSERT_EQ(
-      run_command("ffmpeg -loglevel error -f lavfi -i color=black:s=512x144 -frames:v 1 " + shell_quote(still.string()))
-          .status,
-      0);
+  const auto still = write_lavfi_still(dir, "black.png", "color=black:s=512x144");
   const CommandResult r = run_nelf("simulate " + shell_quote(still.string()) + " --layout sbs --depth estimate -o " +
                                    shell_quote((dir / "retina.png").string()));
   EXPECT_EQ(r.status, 0) << r.err;

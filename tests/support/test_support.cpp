@@ -104,6 +104,16 @@ virtual_image_mm = 1000.0
   return path;
 }
 
+std::filesystem::path write_lavfi_still(const TempDir& dir, const std::string& name, const std::string& source,
+                                        const std::string& filters) {
+  const auto path = dir / name;
+  const CommandResult r = run_command("ffmpeg -loglevel error -f lavfi -i " + shell_quote(source) +
+                                      (filters.empty() ? "" : " -vf " + shell_quote(filters)) + " -frames:v 1 " +
+                                      shell_quote(path.string()));
+  EXPECT_EQ(r.status, 0) << r.err;
+  return path;
+}
+
 std::vector<std::string> files_in(const std::filesystem::path& dir) {
   std::vector<std::string> names;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename().string());

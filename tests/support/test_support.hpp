@@ -62,6 +62,12 @@ class ScopedEnv {
   std::optional<std::string> old_;
 };
 
+// Writes `dir`/`name`, one frame of the ffmpeg CLI's lavfi `source` (e.g. "testsrc2=s=512x144")
+// through the filter graph `filters` (none when empty), and returns its path; a failed ffmpeg run
+// fails the test.
+std::filesystem::path write_lavfi_still(const TempDir& dir, const std::string& name, const std::string& source,
+                                        const std::string& filters = "");
+
 // Quotes a string for /bin/sh.
 std::string shell_quote(const std::string& s);
 
