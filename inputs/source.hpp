@@ -76,6 +76,10 @@ class Source {
   virtual std::unique_ptr<CarriedStreams> open_carried_streams() const { return nullptr; }
   // Frames lost or damaged so far (decode errors, read errors, frames promised but missing).
   virtual std::int64_t lost_frames() const { return 0; }
+  // From another thread: ends a live source (info().live), whose next() may wait for the next
+  // frame as long as nothing changes: a next() waiting returns nullopt within 0.1 s, and every
+  // later one at once. Sources that never wait ignore it.
+  virtual void interrupt() {}
 };
 
 }  // namespace nelf

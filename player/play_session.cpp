@@ -118,6 +118,7 @@ void PlaySession::wait_for_next_refresh() {
 }
 
 PlayResult PlaySession::finish(std::int64_t composited_ahead) {
+  source.interrupt();
   queue.stop();
   decoder.join();
   PlayResult result;

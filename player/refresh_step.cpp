@@ -35,6 +35,10 @@ Refresh choose_frame(PlaySession& s) {
   // later than its sound (mkv: video at 0.023 s, audio at 0) would wait for it for ever. The
   // first frame is the poster shown while the clock waits, whenever its pts.
   if (!state.started && !r.queued.empty()) visible_at = std::max(visible_at, r.queued.front());
+  // A live source (a game's window) is shown as it comes: the newest frame read is due now, the
+  // older ones are dropped, whatever the clock says (its frames are made in real time, they are
+  // never early).
+  if (s.info.live && !r.queued.empty()) visible_at = std::max(visible_at, r.queued.back());
   const FrameDecision d = s.scheduler.decide(visible_at, r.queued, end);
   if (d.drop > 0 || d.show_front) {
     if (auto frame = s.queue.pop(d.drop, d.show_front)) {
