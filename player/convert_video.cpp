@@ -122,6 +122,10 @@ void convert_video(const VideoConvertRequest& r) {
   const int view_w = first->width, view_h = first->height, bits = first->bits;
   const double aspect = first->aspect;
   const std::array<int, 2> block = first->block;
+  // A live input (a window) is recorded until --duration, --frames, its end or Ctrl-C: Ctrl-C ends
+  // the recording with a complete file, as stopping a recording in OBS or ffmpeg does.
+  const bool live = source->info().live;
+  const auto stopping = [live] { return interrupt_requested && !live; };
 
   std::optional<long> total = source->info().expected_frames;
   if (r.duration_s && total)
@@ -141,7 +145,7 @@ void convert_video(const VideoConvertRequest& r) {
     try {
       long count = 0;
       std::optional<StereoVideoFrame> frame = std::move(first);
-      while (frame && !interrupt_requested && !error.failed()) {
+      while (frame && !stopping() && !error.failed()) {
         if (r.max_frames && count >= *r.max_frames) break;
         if (r.duration_s && frame->pts_s >= *r.duration_s - 1e-9) break;
         if (frame->width != view_w || frame->height != view_h || frame->bits != bits || frame->block != block)
@@ -171,7 +175,7 @@ void convert_video(const VideoConvertRequest& r) {
       const std::size_t packed_bytes =
           static_cast<std::size_t>(layout.packed[0]) * layout.packed[1] * bytes_per_pixel(bits);
       while (auto frame = decoded.pop()) {
-        if (interrupt_requested || error.failed()) break;
+        if (stopping() || error.failed()) break;
         const auto shared = std::make_shared<const StereoVideoFrame>(std::move(*frame));
         PackedFrame out{0, 0, 8, buffers.take(packed_bytes), 0.0};
         compositor.render(shared, {}, PackedTarget::bytes(out));
@@ -197,6 +201,10 @@ void convert_video(const VideoConvertRequest& r) {
     ProgressReporter progress(total, ProgressReporter::style_for(r.quiet));
     std::jthread watchdog([&](std::stop_token stop) {
       while (!stop.stop_requested()) {
+        if (interrupt_requested && live) {
+          source->interrupt();  // next() returns nothing more: the queued frames are written
+          return;
+        }
         if (interrupt_requested) {
           decoded.abort();
           packed.abort();
@@ -215,7 +223,7 @@ void convert_video(const VideoConvertRequest& r) {
     watchdog.join();
     decode.join();
     composite.join();
-    if (interrupt_requested) throw UserError("interrupted: no output written", 130);
+    if (stopping()) throw UserError("interrupted: no output written", 130);
     error.rethrow();
     if (const std::int64_t lost = source->lost_frames(); lost > 0) {
       const std::string what = fmt::format("{}: damaged or truncated: {} frame(s) lost or damaged", r.input, lost);
