@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/frame_stamp.hpp"
 #include "core/user_error.hpp"
 
 namespace nelf::playback {
@@ -75,6 +76,7 @@ void present_frame(PlaySession& s, Refresh& r) {
     throw UserError(fmt::format("the display was lost: {}", e.what()), 1);
   }
   r.present_s = seconds_since(t);
+  r.presented_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(Steady::now().time_since_epoch()).count();
   state.dirty = false;
   if (state.started) s.render_time.add(seconds_since(r.decided_at));
   if (!state.started) {
@@ -86,9 +88,18 @@ void present_frame(PlaySession& s, Refresh& r) {
 
 void log_refresh(PlaySession& s, std::int64_t index, const Refresh& r) {
   if (!r.event) return;
-  s.log.write(index, r.event, s.state.current ? std::optional(s.state.current->pts_s) : std::nullopt, s.clock.now(),
+  const FrameCompositor::Frame& current = s.state.current;
+  LiveFrameTimes live;
+  if (s.info.live && current) {
+    live.presented_ns = r.presented_ns;
+    live.captured_ns = current->captured_ns;
+    // A game that stamps its frames (tests/game/) says which one this is and when it presented it.
+    if (current->block == std::array<int, 2>{1, 1})
+      live.game = read_frame_stamp(current->left.data(), current->width, current->height, current->bits);
+  }
+  s.log.write(index, r.event, current ? std::optional(current->pts_s) : std::nullopt, s.clock.now(),
               s.sound.output() ? std::optional(s.sound.output()->now()) : std::nullopt, s.scheduler.counters(),
-              r.upload_s, r.render_s, r.present_s, r.queued.size(), r.ahead);
+              r.upload_s, r.render_s, r.present_s, r.queued.size(), r.ahead, live);
 }
 
 // Not the frames whose time will have passed by the next refresh (it drops them): after a slow
