@@ -10,6 +10,8 @@ bool accepts_synthetic(const SourceRequest& request);
 std::unique_ptr<Source> open_synthetic(const SourceRequest& request);
 bool accepts_x11(const SourceRequest& request);
 std::unique_ptr<Source> open_x11(const SourceRequest& request);
+bool accepts_device(const SourceRequest& request);
+std::unique_ptr<Source> open_device(const SourceRequest& request);
 bool accepts_still(const SourceRequest& request);
 std::unique_ptr<Source> open_still(const SourceRequest& request);
 bool accepts_file(const SourceRequest& request);
@@ -23,6 +25,8 @@ constexpr SourceDriver kDrivers[] = {
      drivers::accepts_synthetic, drivers::open_synthetic},
     {"x11", "x11:[display=:N,fps=N,wait=S,][window=TITLE|window-id=0x…]: a live X11 window (or the screen)",
      drivers::accepts_x11, drivers::open_x11},
+    {"device", "v4l2:/dev/videoN, device:FORMAT:INPUT: an FFmpeg capture device (a capture card, x11grab, lavfi, ...)",
+     drivers::accepts_device, drivers::open_device},
     {"still", "a stereo photo OpenImageIO reads (.jps, .mpo, .png, .jpg, .tif, .exr, ...; two with --right)",
      drivers::accepts_still, drivers::open_still},
     {"file", "a video FFmpeg reads, in any layout (alt: frame-sequential; pair: the right view with --right)",

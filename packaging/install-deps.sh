@@ -16,7 +16,7 @@ packages=(
   # synthetic key presses for the window tests of `nelf calibrate`
   xdotool
   # media: FFmpeg libraries, the ffmpeg CLI for test media and benchmarks, OpenImageIO
-  libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libswresample-dev libavfilter-dev
+  libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libswresample-dev libavfilter-dev libavdevice-dev
   ffmpeg libopenimageio-dev libpng-dev
   # stereo matching for the estimated depth (inputs/stereo_matcher): OpenCV's block matcher
   libopencv-dev

@@ -94,6 +94,34 @@ TEST_F(LiveCliTest, RunStartsTheGamePlaysItsWindowAndEndsWithIt) {
   EXPECT_NE(half.err.find("two 160x180 views, layout sbs-half (flag)"), std::string::npos) << half.err;
 }
 
+TEST_F(LiveCliTest, FfmpegCaptureDevicesAreInputsToo) {
+  // lavfi: a filter graph read as a device; x11grab: FFmpeg's own screen grabber on this Xvfb.
+  const auto graph = dir_.path() / "graph.mkv";
+  const auto r = run_nelf("convert " + shell_quote("device:lavfi:testsrc2=size=640x180:rate=30") + " " +
+                          shell_quote(graph.string()) + " --duration 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("layout sbs (aspect)"), std::string::npos) << r.err;
+  const auto frames = [](const std::filesystem::path& file) {
+    return run_command(
+               "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+               "stream=width,height,nb_read_frames -of csv=p=0 " +
+               shell_quote(file.string()))
+        .out;
+  };
+  EXPECT_EQ(frames(graph), "1280,1470,30\n");
+  const auto screen = dir_.path() / "screen.mkv";
+  const auto grabbed = run_nelf("convert " + shell_quote("device:x11grab:" + xvfb_.display_name()) + " " +
+                                shell_quote(screen.string()) + " --layout mono --frames 5");
+  ASSERT_EQ(grabbed.status, 0) << grabbed.err;
+  EXPECT_EQ(frames(screen), "1280,1470,5\n");
+}
+
+TEST_F(LiveCliTest, ProbeSaysItDescribesFiles) {
+  test::expect_clean_failure(dir_, "probe x11:window=anything", 2,
+                             "probe describes media files; a live input is described by play and convert");
+  test::expect_clean_failure(dir_, "probe device:lavfi:testsrc2", 2, "probe describes media files");
+}
+
 TEST_F(LiveCliTest, RunEndsWithTheGamesStatus) {
   const auto r = run_nelf("run --output offscreen -- sh -c 'exit 3'");
   EXPECT_EQ(r.status, 3);
