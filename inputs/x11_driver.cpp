@@ -9,6 +9,8 @@ extern "C" {
 #include <libswscale/swscale.h>
 }
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstring>
 #include <memory>
@@ -27,19 +29,46 @@ struct ScalerFree {
   void operator()(SwsContext* c) const { sws_freeContext(c); }
 };
 
-std::vector<std::uint8_t> copy_rect(const CapturedImage& image, const PixelRect& rect) {
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(rect.width) * rect.height * 4);
-  for (int y = 0; y < rect.height; ++y)
-    std::memcpy(&out[static_cast<std::size_t>(y) * rect.width * 4],
-                &image.rgba[(static_cast<std::size_t>(rect.y + y) * image.width + rect.x) * 4],
-                static_cast<std::size_t>(rect.width) * 4);
+// `rect` of the image as (width / bx) × (height / by) means of bx × by pixels (1 × 1: a copy), the
+// ViewFormat the compositor negotiated: the compositor's first prefilter pass done while the
+// window's pixels are in cache, and what lets it composite from its CPU tables.
+std::vector<std::uint8_t> view_of(const CapturedImage& image, const PixelRect& rect, std::array<int, 2> block) {
+  const int bx = block[0], by = block[1];
+  const int w = rect.width / bx, h = rect.height / by;
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(w) * h * 4);
+  if (bx == 1 && by == 1) {
+    for (int y = 0; y < h; ++y)
+      std::memcpy(&out[static_cast<std::size_t>(y) * w * 4],
+                  &image.rgba[(static_cast<std::size_t>(rect.y + y) * image.width + rect.x) * 4],
+                  static_cast<std::size_t>(w) * 4);
+    return out;
+  }
+  const unsigned n = static_cast<unsigned>(bx * by);
+  std::vector<unsigned> sums(static_cast<std::size_t>(w) * 3);
+  for (int y = 0; y < h; ++y) {
+    std::fill(sums.begin(), sums.end(), 0u);
+    for (int j = 0; j < by; ++j) {
+      const std::uint8_t* row = &image.rgba[(static_cast<std::size_t>(rect.y + y * by + j) * image.width + rect.x) * 4];
+      for (int x = 0; x < w; ++x)
+        for (int i = 0; i < bx; ++i, row += 4) {
+          sums[x * 3] += row[0];
+          sums[x * 3 + 1] += row[1];
+          sums[x * 3 + 2] += row[2];
+        }
+    }
+    std::uint8_t* dst = &out[static_cast<std::size_t>(y) * w * 4];
+    for (int x = 0; x < w; ++x, dst += 4) {
+      for (int c = 0; c < 3; ++c) dst[c] = static_cast<std::uint8_t>((sums[x * 3 + c] + n / 2) / n);
+      dst[3] = 255;
+    }
+  }
   return out;
 }
 
 class X11FrameSource final : public Source {
  public:
   explicit X11FrameSource(const SourceRequest& r)
-      : input_(r.input), spec_(parse_x11_capture_spec(r.input)), capture_(spec_) {
+      : input_(r.input), spec_(parse_x11_capture_spec(r.input)), capture_(spec_, r.stop) {
     first_ = capture_.read();
     width_ = first_->width;
     height_ = first_->height;
@@ -81,8 +110,9 @@ class X11FrameSource final : public Source {
     frame.width = regions_.left.width;
     frame.height = regions_.left.height;
     frame.bits = 8;
-    frame.left = copy_rect(*image, regions_.left);
-    frame.right = copy_rect(*image, regions_.right);
+    frame.left = view_of(*image, regions_.left, block_);
+    frame.right = view_of(*image, regions_.right, block_);
+    frame.block = block_;
     frame.aspect = regions_.display_aspect;
     frame.pts_s = std::chrono::duration<double>(image->captured_at - origin_).count();
     // steady_clock is CLOCK_MONOTONIC (libstdc++ on Linux): the clock the game's present times use.
@@ -92,6 +122,14 @@ class X11FrameSource final : public Source {
   }
 
   void interrupt() override { interrupted_ = true; }
+
+  // Any block that fits the view: the means are made here, from the window's RGB.
+  ViewFormat negotiate(const ViewFormat& wanted) override {
+    const auto& [bx, by] = wanted.block;
+    const bool fits = bx >= 1 && by >= 1 && bx <= regions_.left.width && by <= regions_.left.height;
+    block_ = fits ? wanted.block : std::array<int, 2>{1, 1};
+    return {block_};
+  }
 
  private:
   CapturedImage scaled(const CapturedImage& image) {
@@ -127,6 +165,7 @@ class X11FrameSource final : public Source {
   ViewRegions regions_;
   std::string description_;
   std::atomic<bool> interrupted_{false};
+  std::array<int, 2> block_{1, 1};  // what negotiate() set
   std::unique_ptr<SwsContext, ScalerFree> scaler_;
   std::pair<int, int> scaled_from_{0, 0};
 };

@@ -93,9 +93,10 @@ void log_refresh(PlaySession& s, std::int64_t index, const Refresh& r) {
   if (s.info.live && current) {
     live.presented_ns = r.presented_ns;
     live.captured_ns = current->captured_ns;
-    // A game that stamps its frames (tests/game/) says which one this is and when it presented it.
-    if (current->block == std::array<int, 2>{1, 1})
-      live.game = read_frame_stamp(current->left.data(), current->width, current->height, current->bits);
+    // A game that stamps its frames (tests/game/) says which one this is and when it presented it
+    // (its cells are fractions of the view: they read from block means too).
+    live.game = read_frame_stamp(current->left.data(), current->width / current->block[0],
+                                 current->height / current->block[1], current->bits);
   }
   s.log.write(index, r.event, current ? std::optional(current->pts_s) : std::nullopt, s.clock.now(),
               s.sound.output() ? std::optional(s.sound.output()->now()) : std::nullopt, s.scheduler.counters(),
