@@ -36,6 +36,9 @@ PlayEnd play_input(const PlayArgs& args, SourceRequest request) {
   if (!args.connector.empty() && args.output != "kms")
     throw UserError("--connector chooses the HDMI connector for --output kms", 2);
 
+  // Before the input opens: Ctrl-C also ends a wait for a window that is not there yet.
+  InterruptGuard guard;
+  request.stop = &interrupt_requested;
   request.right = args.right;
   request.layout = args.right.empty() ? common.layout : StereoLayout::pair;
   request.swap_eyes = args.swap_eyes;
@@ -57,7 +60,6 @@ PlayEnd play_input(const PlayArgs& args, SourceRequest request) {
                         common.profile, common.signal);
   if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", printable(display->description()));
 
-  InterruptGuard guard;
   const PlayResult result = play(*display, *source, options, &interrupt_requested);
   fmt::print(stderr, "nelf: {}\n", play_summary(result));
   if (result.end == PlayEnd::interrupted) throw UserError("interrupted", 130);

@@ -13,6 +13,7 @@
 #include "app/play_command.hpp"
 #include "core/printable.hpp"
 #include "player/game_process.hpp"
+#include "player/interrupt.hpp"
 
 namespace nelf::app {
 namespace {
@@ -25,26 +26,39 @@ struct RunArgs : PlayArgs {
 
 void run_game(const RunArgs& args, const std::vector<std::string>& command) {
   if (args.wait_s <= 0) throw UserError("--wait must be more than 0 seconds", 2);
+  // From the start: a Ctrl-C while the game starts or between its windows ends both too.
+  InterruptGuard guard;
   GameProcess game(command);
   SourceRequest request;
+  request.stop = &interrupt_requested;
   // window= takes the rest of the spec (a title may hold commas), so it comes last.
   request.input = args.window.empty() ? fmt::format("x11:pid={},wait={:g}", game.pid(), args.wait_s)
                                       : fmt::format("x11:wait={:g},window={}", args.wait_s, args.window);
-  PlayEnd end = PlayEnd::end_of_file;
-  try {
-    end = play_input(args, request);
-  } catch (const UserError& e) {
-    // A game that failed before it opened a window says why itself; its status is nelf's.
-    if (const std::optional<int> status = game.exit_status(); status && *status != 0 && e.status() != 130)
-      throw UserError(fmt::format("{} (the game exited with status {})", e.what(), *status), *status);
-    throw;
+  // Games close their window and open another (a splash or launcher first, a new window for a new
+  // video mode): while the game runs, nelf plays each window it opens.
+  for (bool first = true;; first = false) {
+    PlayEnd end = PlayEnd::end_of_file;
+    try {
+      end = play_input(args, request);
+    } catch (const UserError& e) {
+      // A game that failed before it opened a window says why itself; its status is nelf's.
+      if (const std::optional<int> status = game.exit_status(); status && *status != 0 && e.status() != 130)
+        throw UserError(fmt::format("{} (the game exited with status {})", e.what(), *status), *status);
+      if (!first && game.exit_status(std::chrono::milliseconds(1000))) break;  // ended without a new window
+      throw;
+    }
+    if (interrupt_requested) {
+      game.end();
+      throw UserError("interrupted", 130);
+    }
+    if (end != PlayEnd::end_of_file) {
+      game.end();  // the user stopped watching: the game goes with nelf
+      return;
+    }
+    if (game.exit_status(std::chrono::milliseconds(1000))) break;
+    if (!args.quiet) fmt::print(stderr, "nelf: the game's window closed; waiting for its next one\n");
   }
-  if (end != PlayEnd::end_of_file) {
-    game.end();  // the user stopped watching: the game goes with nelf
-    return;
-  }
-  // Its window is gone: the game is ending, or ended.
-  const int status = game.exit_status(std::chrono::milliseconds(10000)).value_or(game.end());
+  const int status = game.exit_status().value_or(game.end());
   if (status != 0) throw UserError(fmt::format("{} exited with status {}", printable(game.name()), status), status);
 }
 

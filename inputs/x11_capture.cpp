@@ -95,7 +95,8 @@ struct WindowInfo {
   std::optional<pid_t> pid;
 };
 
-// Every mapped InputOutput window below `parent`, with its title and process.
+// Every mapped InputOutput window below `parent` that the window manager manages, with its title
+// and process: override-redirect windows (splash screens, menus, tooltips) are never the game.
 void list_windows(::Display* d, Window parent, std::vector<WindowInfo>& out) {
   Window root = 0, up = 0;
   Window* children = nullptr;
@@ -106,7 +107,7 @@ void list_windows(::Display* d, Window parent, std::vector<WindowInfo>& out) {
   for (Window w : kids) {
     XWindowAttributes a{};
     if (!XGetWindowAttributes(d, w, &a)) continue;
-    if (a.map_state == IsViewable && a.c_class == InputOutput)
+    if (a.map_state == IsViewable && a.c_class == InputOutput && !a.override_redirect)
       out.push_back({w, window_title(d, w), a.width, a.height, window_pid(d, w)});
     list_windows(d, w, out);
   }
@@ -358,7 +359,7 @@ struct X11Capture::State {
   }
 };
 
-X11Capture::X11Capture(const X11CaptureSpec& spec) : state_(std::make_unique<State>()) {
+X11Capture::X11Capture(const X11CaptureSpec& spec, const std::atomic<bool>* stop) : state_(std::make_unique<State>()) {
   State& s = *state_;
   const char* env = std::getenv("DISPLAY");
   const std::string name = !spec.display.empty() ? spec.display : env ? env : "";
@@ -418,6 +419,7 @@ X11Capture::X11Capture(const X11CaptureSpec& spec) : state_(std::make_unique<Sta
         s.description = fmt::format("window 0x{:x} \"{}\"", s.window, printable(found[0].title));
         break;
       }
+      if (stop && stop->load()) throw UserError("interrupted while waiting for the window", 130);
       if (spec.pid && !process_alive(*spec.pid))
         throw UserError(fmt::format("x11: process {} ended without opening a window", *spec.pid), 1);
       if (Clock::now() >= give_up)

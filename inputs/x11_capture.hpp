@@ -6,6 +6,7 @@
 // by a substring of its title, by its id, or by the process that made it (`nelf run`).
 #include <sys/types.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -44,7 +45,8 @@ class X11Capture {
   // or not mapped. Throws UserError (status 1) when the display cannot be opened, the window is not
   // found, or the server lacks Composite or Damage; status 2 when a title matches several windows
   // (they are listed, to choose one by id).
-  explicit X11Capture(const X11CaptureSpec& spec);
+  // `stop` (may be null), set from another thread, ends the wait with status 130.
+  explicit X11Capture(const X11CaptureSpec& spec, const std::atomic<bool>* stop = nullptr);
   ~X11Capture();
   X11Capture(const X11Capture&) = delete;
   X11Capture& operator=(const X11Capture&) = delete;

@@ -109,9 +109,9 @@ std::unique_ptr<FrameSink> open_frame_sink(const VideoConvertRequest& r, Source&
 
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
-  std::unique_ptr<Source> source = open_source_for_depth(
-      SourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels},
-      r.compositor.depth, r.profile);
+  SourceRequest request{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels};
+  request.stop = &interrupt_requested;
+  std::unique_ptr<Source> source = open_source_for_depth(request, r.compositor.depth, r.profile);
   // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
   const ViewGeometry view = source->info().view;
   source->negotiate({stereo_prefilter_block(r.profile, r.compositor, view.width, view.height, view.aspect)});
@@ -151,7 +151,8 @@ void convert_video(const VideoConvertRequest& r) {
         if (frame->width != view_w || frame->height != view_h || frame->bits != bits || frame->block != block)
           throw UserError(fmt::format("{}: the frame size changed mid-stream", r.input), 1);
         if (!decoded.push(std::move(*frame))) return;
-        ++count;
+        // Not one frame more than --frames is asked of the source: a live one may wait long for it.
+        if (r.max_frames && ++count >= *r.max_frames) break;
         frame = source->next();
       }
       decoded.close();
