@@ -12,8 +12,8 @@ namespace nelf::app {
 
 namespace {
 constexpr CommandRegistrar registrars[] = {
-    add_profiles_command, add_design_command, add_convert_command,   add_probe_command,
-    add_simulate_command, add_play_command,   add_calibrate_command,
+    add_profiles_command, add_design_command, add_convert_command, add_probe_command,
+    add_simulate_command, add_play_command,   add_run_command,     add_calibrate_command,
 };
 
 // CLI11 reads "nan" and "inf" as numbers; no option of nelf means either (a time, a diameter).

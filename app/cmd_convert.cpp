@@ -268,9 +268,15 @@ void refuse_gpu_for_live_output(const std::optional<int>& gpu, const std::string
                   2);
 }
 
-void add_common_options(CLI::App& cmd, CommonArgs& args) {
-  cmd.add_option("input", args.input, "Stereo image or video (side-by-side, top-bottom, frame-packed, JPS, MPO, ...)")
+void add_input_option(CLI::App& cmd, CommonArgs& args) {
+  cmd.add_option("input", args.input,
+                 "Stereo image or video (side-by-side, top-bottom, frame-packed, JPS, MPO, ...), or a live window "
+                 "(x11:window=TITLE)")
       ->required();
+}
+
+void add_common_options(CLI::App& cmd, CommonArgs& args, bool with_input) {
+  if (with_input) add_input_option(cmd, args);
   cmd.add_option("--profile", args.profile, "Device profile: built-in name or TOML file")->capture_default_str();
   cmd.add_option("--layout", args.layout,
                  fmt::format("Stereo layout of the input: auto, {}", fmt::join(stereo_layout_names(), ", ")))

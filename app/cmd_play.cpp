@@ -7,6 +7,7 @@
 #include <string>
 
 #include "app/commands.hpp"
+#include "app/play_command.hpp"
 #include "core/printable.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/display_drivers.hpp"
@@ -19,18 +20,8 @@
 #include "player/player.hpp"
 
 namespace nelf::app {
-namespace {
 
-struct PlayArgs : CommonArgs {
-  std::string output = "window";
-  std::string monitor;
-  std::string connector;
-  bool no_audio = false;
-  bool quiet = false;
-  std::string log_frames;
-};
-
-void run_play(const PlayArgs& args) {
+PlayEnd play_input(const PlayArgs& args, SourceRequest request) {
   quiet_ffmpeg_logs(true);
   // Off screen, play renders headless like convert, on the GPU --gpu picks.
   if (args.output != "offscreen") refuse_gpu_for_live_output(args.gpu, "play");
@@ -45,8 +36,9 @@ void run_play(const PlayArgs& args) {
   if (!args.connector.empty() && args.output != "kms")
     throw UserError("--connector chooses the HDMI connector for --output kms", 2);
 
-  SourceRequest request;
-  request.input = args.input;
+  // Before the input opens: Ctrl-C also ends a wait for a window that is not there yet.
+  InterruptGuard guard;
+  request.stop = &interrupt_requested;
   request.right = args.right;
   request.layout = args.right.empty() ? common.layout : StereoLayout::pair;
   request.swap_eyes = args.swap_eyes;
@@ -64,31 +56,38 @@ void run_play(const PlayArgs& args) {
   options.quiet = args.quiet;
 
   const auto display =
-      open_live_display({args.output, args.monitor, args.connector, fmt::format("nelf: {}", args.input), args.gpu},
+      open_live_display({args.output, args.monitor, args.connector, fmt::format("nelf: {}", request.input), args.gpu},
                         common.profile, common.signal);
   if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", printable(display->description()));
 
-  InterruptGuard guard;
   const PlayResult result = play(*display, *source, options, &interrupt_requested);
   fmt::print(stderr, "nelf: {}\n", play_summary(result));
   if (result.end == PlayEnd::interrupted) throw UserError("interrupted", 130);
+  return result.end;
 }
 
-}  // namespace
+void add_play_options(CLI::App& cmd, PlayArgs& args) {
+  add_common_options(cmd, args, false);
+  cmd.add_option("--output", args.output, fmt::format("Where to show it: {}", display_driver_help()))
+      ->capture_default_str();
+  cmd.add_option("--monitor", args.monitor, "fullscreen: the monitor (default: the one named like HMZ)");
+  cmd.add_option("--connector", args.connector, "kms: the connector, e.g. HDMI-A-1 (default: the first with 3D)");
+  cmd.add_flag("--no-audio", args.no_audio, "Play without sound (the system clock paces the video)");
+  cmd.add_flag("--quiet", args.quiet, "Only warnings and the summary line at exit");
+  cmd.add_option("--log-frames", args.log_frames,
+                 "Diagnostics: write a CSV line per presented refresh (pts, clock, audio clock, counters)");
+}
 
 void add_play_command(CLI::App& app) {
   auto args = std::make_shared<PlayArgs>();
   auto* cmd = app.add_subcommand("play", "Watch a stereo video on the display (HMD over HDMI, or a preview window)");
-  add_common_options(*cmd, *args);
-  cmd->add_option("--output", args->output, fmt::format("Where to show it: {}", display_driver_help()))
-      ->capture_default_str();
-  cmd->add_option("--monitor", args->monitor, "fullscreen: the monitor (default: the one named like HMZ)");
-  cmd->add_option("--connector", args->connector, "kms: the connector, e.g. HDMI-A-1 (default: the first with 3D)");
-  cmd->add_flag("--no-audio", args->no_audio, "Play without sound (the system clock paces the video)");
-  cmd->add_flag("--quiet", args->quiet, "Only warnings and the summary line at exit");
-  cmd->add_option("--log-frames", args->log_frames,
-                  "Diagnostics: write a CSV line per presented refresh (pts, clock, audio clock, counters)");
-  cmd->callback([args] { run_play(*args); });
+  add_input_option(*cmd, *args);
+  add_play_options(*cmd, *args);
+  cmd->callback([args] {
+    SourceRequest request;
+    request.input = args->input;
+    play_input(*args, request);
+  });
 }
 
 }  // namespace nelf::app

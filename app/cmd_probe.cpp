@@ -10,6 +10,7 @@
 
 #include "app/commands.hpp"
 #include "core/printable.hpp"
+#include "inputs/source_drivers.hpp"
 #include "inputs/stereo_layout.hpp"
 #include "inputs/video_source.hpp"
 
@@ -39,8 +40,16 @@ struct ProbeResult {
 
 ProbeResult probe(const ProbeOptions& options) {
   quiet_ffmpeg_logs(true);
-  VideoSource source(options.input,
-                     VideoSourceOptions{.allow_network = options.allow_network, .max_pixels = options.max_pixels});
+  // A live input has no file to describe: play and convert print what they read of it.
+  SourceRequest request;
+  request.input = options.input;
+  if (const std::string driver(source_driver_for(request).name); driver == "x11" || driver == "device")
+    throw UserError(fmt::format("{}: probe describes media files; a live input is described by play and convert",
+                                printable(options.input)),
+                    2);
+  VideoSource source(
+      options.input,
+      VideoSourceOptions{.allow_network = options.allow_network, .max_pixels = options.max_pixels, .device = {}});
   int decoded = 0;
   bool any_frame = false;
   while (decoded < kMaxFramesBeforeKeyframe) {

@@ -47,8 +47,10 @@ struct CommonOptions {
   Signal signal;
 };
 
-// Registers INPUT (positional) and the CommonArgs options on `cmd`.
-void add_common_options(CLI::App& cmd, CommonArgs& args);
+// Registers INPUT (positional, unless !with_input) and the CommonArgs options on `cmd`.
+void add_common_options(CLI::App& cmd, CommonArgs& args, bool with_input = true);
+// Registers INPUT alone (play registers it before its options, run has none).
+void add_input_option(CLI::App& cmd, CommonArgs& args);
 // Registers --no-defect-compensation (shared by convert, play and calibrate: one wording).
 void add_defect_compensation_option(CLI::App& cmd, bool& no_defect_compensation);
 // Registers --depth (shared by convert, play and simulate: one wording), and the mode it names.
@@ -86,6 +88,7 @@ void add_convert_command(CLI::App& app);
 void add_probe_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_play_command(CLI::App& app);
+void add_run_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
 
 // Names `app` nelf and adds --version and every subcommand (app/cli.cpp): the command line that

@@ -44,6 +44,7 @@ struct StereoVideoFrame {
   // `nelf convert` composes a still from, so that its output never goes through `bits`.
   std::shared_ptr<const StereoPair> exact_views;
   std::shared_ptr<const StereoDisparity> disparity;  // the content's depth, when known or estimated
+  std::int64_t captured_ns = 0;  // a live source's frame: CLOCK_MONOTONIC when it was read; 0 otherwise
 };
 
 inline std::size_t bytes_per_pixel(int bits) { return bits > 8 ? 8 : 4; }

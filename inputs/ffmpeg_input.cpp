@@ -49,7 +49,7 @@ int guarded_io_open(AVFormatContext* context, AVIOContext** pb, const char* url,
 // calls this at least every 100 ms while it waits.
 int interrupt_when_stopped(void* opaque) {
   auto* guard = static_cast<InputGuard*>(opaque);
-  if (!guard->refused_protocol.empty()) return 1;
+  if (guard->interrupted.load() || !guard->refused_protocol.empty()) return 1;
   if (guard->opening_deadline && std::chrono::steady_clock::now() >= *guard->opening_deadline) {
     guard->opening_stopped = true;
     return 1;
@@ -66,11 +66,12 @@ bool is_regular_file(const std::string& path) {
 
 bool is_url(const std::string& path) { return path.find("://") != std::string::npos || path.rfind("pipe:", 0) == 0; }
 
-int open_input(FormatContextPtr& format, const std::string& path, InputGuard& guard) {
-  const std::string url = is_url(path) ? path : "file:" + path;
+int open_input(FormatContextPtr& format, const std::string& path, InputGuard& guard, const AVInputFormat* device) {
+  const std::string url = device != nullptr || is_url(path) ? path : "file:" + path;
   AVFormatContext* raw = avformat_alloc_context();
   if (raw == nullptr) return AVERROR(ENOMEM);
   AVDictionary* raw_options = nullptr;
+  raw->interrupt_callback = AVIOInterruptCB{interrupt_when_stopped, &guard};
   if (!guard.allow_network) {
     if (default_io_open() == nullptr) {
       avformat_free_context(raw);
@@ -78,8 +79,7 @@ int open_input(FormatContextPtr& format, const std::string& path, InputGuard& gu
     }
     raw->opaque = &guard;
     raw->io_open = guarded_io_open;
-    raw->interrupt_callback = AVIOInterruptCB{interrupt_when_stopped, &guard};
-    if (!is_url(path) && is_regular_file(path))
+    if (device == nullptr && !is_url(path) && is_regular_file(path))
       guard.opening_deadline = std::chrono::steady_clock::now() + guard.opening_limit;
     // Kept as the second line of defence, and for what reaches FFmpeg without io_open.
     av_dict_set(&raw_options, "protocol_whitelist", "file,pipe", 0);
@@ -88,7 +88,7 @@ int open_input(FormatContextPtr& format, const std::string& path, InputGuard& gu
     // writes to it while nelf reads (found by fuzzing): give up after two reloads that bring nothing.
     av_dict_set(&raw_options, "m3u8_hold_counters", "2", 0);
   }
-  const int opened = avformat_open_input(&raw, url.c_str(), nullptr, &raw_options);  // frees raw on failure
+  const int opened = avformat_open_input(&raw, url.c_str(), device, &raw_options);  // frees raw on failure
   DictionaryPtr unused(raw_options);
   if (opened >= 0) format.reset(raw);
   return opened;

@@ -3,6 +3,7 @@
 // passes --allow-network, FFmpeg may read local files and pipes only — the input itself and every
 // URL it names (HLS segments, concat lists, ...) — and with a bound on how long opening a local
 // file may wait. One place, for the video, the audio and the packets carried into an output.
+#include <atomic>
 #include <chrono>
 #include <optional>
 #include <string>
@@ -28,13 +29,18 @@ struct InputGuard {
   std::string refused_protocol;  // the first protocol refused, e.g. "http"; empty: none
   bool opening_stopped = false;  // opening took longer than opening_limit and was interrupted
   std::optional<std::chrono::steady_clock::time_point> opening_deadline;  // set while opening
+  // Set from another thread: FFmpeg gives up what it waits for (a capture device's next frame).
+  std::atomic<bool> interrupted{false};
 };
 
 // avformat_open_input for `path` (a file name, made a "file:" URL so a colon in it is no protocol,
 // or a URL) into `format`; returns its status (< 0: an AVERROR). Unless guard.allow_network, every
 // URL the demuxer opens on a protocol other than file or pipe is refused and recorded in `guard`,
 // and opening a regular file is interrupted after guard.opening_limit (until find_stream_info).
-int open_input(FormatContextPtr& format, const std::string& path, InputGuard& guard);
+// With `device` (a libavdevice input format: v4l2, x11grab, lavfi, …), `path` is the device's own
+// name for its input (/dev/video0, :0.0, a filter graph), opened as it is.
+int open_input(FormatContextPtr& format, const std::string& path, InputGuard& guard,
+               const AVInputFormat* device = nullptr);
 
 // avformat_find_stream_info under the same guard, `options` as FFmpeg takes them (one dictionary per
 // stream, or null); ends the opening deadline, so that reading later is never interrupted by it.

@@ -33,8 +33,16 @@ std::vector<std::uint8_t> copy_region(const VideoFrame& frame, const PixelRect& 
 
 class FileFrameSource final : public Source {
  public:
-  FileFrameSource(const SourceRequest& r)
-      : path_(r.input), allow_network_(r.allow_network), source_(open(r.input, r)) {
+  // `device`: a libavdevice input format, `device_input` what it reads (the device driver's inputs).
+  explicit FileFrameSource(const SourceRequest& r, std::string device = {}, std::string device_input = {})
+      : path_(r.input),
+        allow_network_(r.allow_network),
+        device_(std::move(device)),
+        source_(device_.empty() ? open(r.input, r) : open_device(r.input, device_input, r, device_)) {
+    if (!device_.empty() && r.start_s)
+      throw UserError(fmt::format("{}: --start needs a file; a capture device is read live", r.input), 2);
+    if (!device_.empty() && r.layout == StereoLayout::pair)
+      throw UserError(fmt::format("{}: layout pair needs two files; a capture device is one stream", r.input), 2);
     if (r.start_s) source_.seek(*r.start_s);
     pending_ = source_.next_frame();
     if (!pending_ && r.start_s && source_.info().duration_s && *r.start_s >= *source_.info().duration_s)
@@ -133,12 +141,16 @@ class FileFrameSource final : public Source {
     return out;
   }
 
+  // A device cannot be opened a second time for its sound while its video is read.
   OpenedAudio open_audio(AudioFormat format) const override {
+    if (!device_.empty()) return {nullptr, "a capture device's sound is not read"};
     return open_file_audio(path_, origin_s_, allow_network_, format);
   }
   std::unique_ptr<CarriedStreams> open_carried_streams() const override {
+    if (!device_.empty()) return nullptr;
     return open_file_carried_streams(path_, origin_s_, allow_network_);
   }
+  void interrupt() override { source_.interrupt(); }
   SourceInfo info() const override {
     const VideoInfo& video = source_.info();
     SourceInfo info;
@@ -149,17 +161,20 @@ class FileFrameSource final : public Source {
       frames = static_cast<double>(*video.frame_count);
     else if (video.duration_s && video.fps > 0)
       frames = *video.duration_s * video.fps;
-    if (frames) {
+    if (frames && !video.live) {
       if (decision_.layout == StereoLayout::alt) *frames /= 2;
       info.expected_frames = static_cast<long>(std::lround(*frames));
     }
-    if (video.duration_s) info.duration_s = std::max(0.0, *video.duration_s - (origin_s_ - video.start_time_s));
+    info.live = video.live;
+    if (video.duration_s && !video.live)
+      info.duration_s = std::max(0.0, *video.duration_s - (origin_s_ - video.start_time_s));
     info.seekable = video.seekable && (!right_ || right_->info().seekable);
     info.description = description_;
     info.view = view_geometry();
     return info;
   }
   void seek(double seconds) override {
+    if (!device_.empty()) throw UserError(fmt::format("{}: a capture device cannot seek", path_), 1);
     // The source's own clock starts at its start time; pts_s 0 is origin_s_.
     const double from_start = std::max(0.0, origin_s_ - source_.info().start_time_s + seconds);
     pending_.reset();
@@ -203,9 +218,21 @@ class FileFrameSource final : public Source {
  private:
   static VideoSource open(const std::string& path, const SourceRequest& r) {
     try {
-      return VideoSource(path, VideoSourceOptions{r.allow_network, true, r.max_pixels});
+      return VideoSource(path, VideoSourceOptions{r.allow_network, true, r.max_pixels, {}});
     } catch (const VideoError& e) {
       throw UserError(e.what(), 1);
+    }
+  }
+  // The device's messages name the input as the user wrote it (v4l2:/dev/video0), not what the
+  // device was given (/dev/video0).
+  static VideoSource open_device(const std::string& spec, const std::string& device_input, const SourceRequest& r,
+                                 const std::string& device) {
+    try {
+      return VideoSource(device_input, VideoSourceOptions{r.allow_network, true, r.max_pixels, device});
+    } catch (const VideoError& e) {
+      std::string what = e.what();
+      if (what.rfind(device_input + ": ", 0) == 0) what.erase(0, device_input.size() + 2);
+      throw UserError(fmt::format("{}: {}", spec, what), 1);
     }
   }
   std::optional<VideoFrame> take() {
@@ -226,6 +253,7 @@ class FileFrameSource final : public Source {
 
   std::string path_;
   bool allow_network_;  // for the audio and carried streams, opened on their own
+  std::string device_;  // a capture device's input format; empty for a file
   std::string description_;
   VideoSource source_;
   std::optional<VideoSource> right_;
@@ -243,5 +271,10 @@ class FileFrameSource final : public Source {
 bool accepts_file(const SourceRequest& /*request*/) { return true; }
 
 std::unique_ptr<Source> open_file(const SourceRequest& request) { return std::make_unique<FileFrameSource>(request); }
+
+std::unique_ptr<Source> open_ffmpeg_device(const SourceRequest& request, const std::string& device,
+                                           const std::string& device_input) {
+  return std::make_unique<FileFrameSource>(request, device, device_input);
+}
 
 }  // namespace nelf::drivers

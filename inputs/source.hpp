@@ -4,6 +4,7 @@
 // right view), a still (JPS, MPO, an image pair) or the built-in `synthetic:` clip. Shared by
 // `nelf convert` and `nelf play`, so that both honour --layout, --right and --swap-eyes identically.
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -36,6 +37,9 @@ struct SourceRequest {
   // Attach the depth the source knows to its frames (StereoVideoFrame::disparity: the synthetic
   // scenes' exact depth), for `--depth auto`; sources that know none ignore it.
   bool known_depth = false;
+  // Set from elsewhere (Ctrl-C): a live source waiting, while it opens, for what it reads (a window
+  // that is not there yet) gives up, with status 130.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 // What a source says about its stream once it is open.
@@ -76,6 +80,10 @@ class Source {
   virtual std::unique_ptr<CarriedStreams> open_carried_streams() const { return nullptr; }
   // Frames lost or damaged so far (decode errors, read errors, frames promised but missing).
   virtual std::int64_t lost_frames() const { return 0; }
+  // From another thread: ends a live source (info().live), whose next() may wait for the next
+  // frame as long as nothing changes: a next() waiting returns nullopt within 0.1 s, and every
+  // later one at once. Sources that never wait ignore it.
+  virtual void interrupt() {}
 };
 
 }  // namespace nelf

@@ -8,6 +8,10 @@ namespace nelf {
 namespace drivers {
 bool accepts_synthetic(const SourceRequest& request);
 std::unique_ptr<Source> open_synthetic(const SourceRequest& request);
+bool accepts_x11(const SourceRequest& request);
+std::unique_ptr<Source> open_x11(const SourceRequest& request);
+bool accepts_device(const SourceRequest& request);
+std::unique_ptr<Source> open_device(const SourceRequest& request);
 bool accepts_still(const SourceRequest& request);
 std::unique_ptr<Source> open_still(const SourceRequest& request);
 bool accepts_file(const SourceRequest& request);
@@ -19,6 +23,10 @@ namespace {
 constexpr SourceDriver kDrivers[] = {
     {"synthetic", "synthetic:[duration=S,fps=N,size=WxH]: a stereo clip nelf renders itself, with a tone",
      drivers::accepts_synthetic, drivers::open_synthetic},
+    {"x11", "x11:[display=:N,fps=N,wait=S,][window=TITLE|window-id=0x…]: a live X11 window (or the screen)",
+     drivers::accepts_x11, drivers::open_x11},
+    {"device", "v4l2:/dev/videoN, device:FORMAT:INPUT: an FFmpeg capture device (a capture card, x11grab, lavfi, ...)",
+     drivers::accepts_device, drivers::open_device},
     {"still", "a stereo photo OpenImageIO reads (.jps, .mpo, .png, .jpg, .tif, .exr, ...; two with --right)",
      drivers::accepts_still, drivers::open_still},
     {"file", "a video FFmpeg reads, in any layout (alt: frame-sequential; pair: the right view with --right)",

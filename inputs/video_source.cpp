@@ -14,6 +14,7 @@
 #include "inputs/yuv_block_means.hpp"
 
 extern "C" {
+#include <libavdevice/avdevice.h>
 #include <libavutil/display.h>
 #include <libavutil/imgutils.h>
 #include <libavutil/pixdesc.h>
@@ -119,7 +120,16 @@ struct VideoSource::Impl {
 
   void open(const std::string& path) {
     info.path = path;
-    if (!is_url(path)) {
+    const AVInputFormat* device = nullptr;
+    if (!options.device.empty()) {
+      static const bool registered = (avdevice_register_all(), true);
+      (void)registered;
+      device = av_find_input_format(options.device.c_str());
+      if (device == nullptr || device->priv_class == nullptr || !AV_IS_INPUT_DEVICE(device->priv_class->category))
+        throw VideoError(
+            fmt::format("{}: FFmpeg has no input device '{}' (ffmpeg -devices lists them)", path, options.device));
+      info.live = true;
+    } else if (!is_url(path)) {
       std::error_code ec;
       const auto status = std::filesystem::status(path, ec);
       if (!std::filesystem::exists(status)) fail("no such file");
@@ -128,7 +138,7 @@ struct VideoSource::Impl {
 
     // Playlists (HLS, concat, …) can otherwise make FFmpeg fetch URLs (DESIGN.md §11).
     network.allow_network = options.allow_network;
-    const int opened = open_input(format, path, network);
+    const int opened = open_input(format, path, network, device);
     if (const auto stopped = guard_stop(path, network)) throw VideoError(*stopped);
     if (opened < 0) {
       if (opened == AVERROR_INVALIDDATA) fail("not a media file FFmpeg can read");
@@ -235,7 +245,7 @@ struct VideoSource::Impl {
       info.start_time_s = static_cast<double>(stream->start_time) * av_q2d(stream->time_base);
     if (stream->nb_frames > 0) info.frame_count = stream->nb_frames;
     // A pipe cannot go back; image2 and other demuxers without their own I/O seek by reopening.
-    info.seekable = !format->pb || (format->pb->seekable & AVIO_SEEKABLE_NORMAL) != 0;
+    info.seekable = !info.live && (!format->pb || (format->pb->seekable & AVIO_SEEKABLE_NORMAL) != 0);
 
     const auto pixel_format = static_cast<AVPixelFormat>(par.format);
     if (const char* name = av_get_pix_fmt_name(pixel_format)) info.pixel_format = name;
@@ -496,6 +506,12 @@ struct VideoSource::Impl {
   std::optional<VideoFrame> next_frame() {
     if (finished) return std::nullopt;
     for (;;) {
+      // Not every device checks FFmpeg's interrupt callback while it waits (x11grab sleeps to its
+      // next frame): an interrupted one ends at its next frame at the latest.
+      if (network.interrupted) {
+        finished = true;
+        return std::nullopt;
+      }
       const int received = avcodec_receive_frame(codec.get(), frame.get());
       if (received == 0) {
         consecutive_errors = 0;
@@ -529,7 +545,7 @@ struct VideoSource::Impl {
       }
       const int read = av_read_frame(format.get(), packet.get());
       if (read < 0) {
-        if (read != AVERROR_EOF) ++stats.read_errors;
+        if (read != AVERROR_EOF && !network.interrupted) ++stats.read_errors;  // interrupted: ended, not lost
         draining = true;
         avcodec_send_packet(codec.get(), nullptr);
         continue;
@@ -618,6 +634,8 @@ std::optional<StereoMetadata> VideoSource::stereo_metadata() const {
   return impl_->info.stream_stereo ? impl_->info.stream_stereo : impl_->frame_stereo;
 }
 std::optional<StereoMetadata> VideoSource::frame_stereo_metadata() const { return impl_->frame_stereo; }
+
+void VideoSource::interrupt() { impl_->network.interrupted = true; }
 
 void quiet_ffmpeg_logs(bool quiet) { av_log_set_level(quiet ? AV_LOG_QUIET : AV_LOG_INFO); }
 

@@ -54,6 +54,7 @@ struct VideoInfo {
   double start_time_s = 0.0;                // pts of the first frame, as the container says
   std::optional<std::int64_t> frame_count;  // from the container's index, when it has one
   bool seekable = true;                     // false for a pipe: seek() then fails
+  bool live = false;                        // a capture device (VideoSourceOptions::device)
   int audio_streams = 0;
   int bits_per_component = 8;  // of the source (8, 10, 12, 16); delivered frames use 8 or 16
   ColorMatrix matrix = ColorMatrix::bt709;
@@ -97,6 +98,9 @@ struct VideoSourceOptions {
   bool apply_rotation = true;  // false: deliver frames as stored and leave rotation to the caller
   // --max-pixels: a stream, or a frame of it, larger than this is refused before it is decoded.
   std::int64_t max_pixels = kDefaultMaxPixels;
+  // A libavdevice input format (v4l2, x11grab, lavfi, …): the path is then that device's name for
+  // its input (/dev/video0, :0.0, a filter graph), read live. Empty: a file or URL.
+  std::string device;
 };
 
 // What went wrong while decoding, so that the caller can warn (or refuse, with --strict).
@@ -148,6 +152,9 @@ class VideoSource {
   std::optional<StereoMetadata> stereo_metadata() const;
   // The frame-packing SEI remembered from decoding, regardless of the container.
   std::optional<StereoMetadata> frame_stereo_metadata() const;
+  // From another thread: a next_frame() waiting for a device's next frame returns nothing (the
+  // end), and so does every later one.
+  void interrupt();
 
  private:
   struct Impl;

@@ -11,10 +11,12 @@ packages=(
   # graphics: EGL/OpenGL through epoxy, Mesa's llvmpipe for GPU-less tests, GLFW windows, KMS/GBM
   libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libgbm-dev libdrm-dev libglfw3-dev libxrandr-dev libx11-dev
   glslang-tools xvfb xauth
+  # live capture (x11: windows through Composite, Damage and MIT-SHM)
+  libxcomposite-dev libxdamage-dev libxext-dev
   # synthetic key presses for the window tests of `nelf calibrate`
   xdotool
   # media: FFmpeg libraries, the ffmpeg CLI for test media and benchmarks, OpenImageIO
-  libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libswresample-dev libavfilter-dev
+  libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libswresample-dev libavfilter-dev libavdevice-dev
   ffmpeg libopenimageio-dev libpng-dev
   # stereo matching for the estimated depth (inputs/stereo_matcher): OpenCV's block matcher
   libopencv-dev

@@ -109,9 +109,9 @@ std::unique_ptr<FrameSink> open_frame_sink(const VideoConvertRequest& r, Source&
 
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
-  std::unique_ptr<Source> source = open_source_for_depth(
-      SourceRequest{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels},
-      r.compositor.depth, r.profile);
+  SourceRequest request{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels};
+  request.stop = &interrupt_requested;
+  std::unique_ptr<Source> source = open_source_for_depth(request, r.compositor.depth, r.profile);
   // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
   const ViewGeometry view = source->info().view;
   source->negotiate({stereo_prefilter_block(r.profile, r.compositor, view.width, view.height, view.aspect)});
@@ -122,6 +122,10 @@ void convert_video(const VideoConvertRequest& r) {
   const int view_w = first->width, view_h = first->height, bits = first->bits;
   const double aspect = first->aspect;
   const std::array<int, 2> block = first->block;
+  // A live input (a window) is recorded until --duration, --frames, its end or Ctrl-C: Ctrl-C ends
+  // the recording with a complete file, as stopping a recording in OBS or ffmpeg does.
+  const bool live = source->info().live;
+  const auto stopping = [live] { return interrupt_requested && !live; };
 
   std::optional<long> total = source->info().expected_frames;
   if (r.duration_s && total)
@@ -141,13 +145,14 @@ void convert_video(const VideoConvertRequest& r) {
     try {
       long count = 0;
       std::optional<StereoVideoFrame> frame = std::move(first);
-      while (frame && !interrupt_requested && !error.failed()) {
+      while (frame && !stopping() && !error.failed()) {
         if (r.max_frames && count >= *r.max_frames) break;
         if (r.duration_s && frame->pts_s >= *r.duration_s - 1e-9) break;
         if (frame->width != view_w || frame->height != view_h || frame->bits != bits || frame->block != block)
           throw UserError(fmt::format("{}: the frame size changed mid-stream", r.input), 1);
         if (!decoded.push(std::move(*frame))) return;
-        ++count;
+        // Not one frame more than --frames is asked of the source: a live one may wait long for it.
+        if (r.max_frames && ++count >= *r.max_frames) break;
         frame = source->next();
       }
       decoded.close();
@@ -171,7 +176,7 @@ void convert_video(const VideoConvertRequest& r) {
       const std::size_t packed_bytes =
           static_cast<std::size_t>(layout.packed[0]) * layout.packed[1] * bytes_per_pixel(bits);
       while (auto frame = decoded.pop()) {
-        if (interrupt_requested || error.failed()) break;
+        if (stopping() || error.failed()) break;
         const auto shared = std::make_shared<const StereoVideoFrame>(std::move(*frame));
         PackedFrame out{0, 0, 8, buffers.take(packed_bytes), 0.0};
         compositor.render(shared, {}, PackedTarget::bytes(out));
@@ -197,6 +202,10 @@ void convert_video(const VideoConvertRequest& r) {
     ProgressReporter progress(total, ProgressReporter::style_for(r.quiet));
     std::jthread watchdog([&](std::stop_token stop) {
       while (!stop.stop_requested()) {
+        if (interrupt_requested && live) {
+          source->interrupt();  // next() returns nothing more: the queued frames are written
+          return;
+        }
         if (interrupt_requested) {
           decoded.abort();
           packed.abort();
@@ -215,7 +224,7 @@ void convert_video(const VideoConvertRequest& r) {
     watchdog.join();
     decode.join();
     composite.join();
-    if (interrupt_requested) throw UserError("interrupted: no output written", 130);
+    if (stopping()) throw UserError("interrupted: no output written", 130);
     error.rethrow();
     if (const std::int64_t lost = source->lost_frames(); lost > 0) {
       const std::string what = fmt::format("{}: damaged or truncated: {} frame(s) lost or damaged", r.input, lost);

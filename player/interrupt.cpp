@@ -11,7 +11,10 @@ extern "C" void on_interrupt(int) { interrupt_requested.store(true); }
 }  // namespace
 
 InterruptGuard::InterruptGuard() {
-  interrupt_requested.store(false);
+  // A guard inside another (play within nelf run) keeps what the outer one has seen.
+  struct sigaction current {};
+  sigaction(SIGINT, nullptr, &current);
+  if (current.sa_handler != on_interrupt) interrupt_requested.store(false);
   struct sigaction action {};
   action.sa_handler = on_interrupt;
   sigemptyset(&action.sa_mask);

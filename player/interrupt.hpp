@@ -15,7 +15,8 @@ extern std::atomic<bool> interrupt_requested;
 // The signals an InterruptGuard turns into `interrupt_requested`.
 inline constexpr int interrupt_signals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
 
-// Installs the handlers for its lifetime (clearing the flag) and restores the previous ones.
+// Installs the handlers for its lifetime (clearing the flag, unless it is inside another guard)
+// and restores the previous ones.
 class InterruptGuard {
  public:
   InterruptGuard();

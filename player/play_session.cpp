@@ -66,7 +66,10 @@ PlaySession::PlaySession(Display& display_, Source& source_, const PlayerOptions
       clock(paused_master_clock(sound, options)),
       refresh_period(1.0 / display.refresh_hz()),
       info(source.info()),
-      scheduler(refresh_period, info.frame_rate > 0 ? 1.0 / info.frame_rate : 0.0),
+      // A live source's rate is the most it reads (x11: fps=), not the game's: its period is
+      // estimated from the frames, so that a refresh without a new one is a repeat only when the
+      // game is late for its own cadence.
+      scheduler(refresh_period, info.frame_rate > 0 && !info.live ? 1.0 / info.frame_rate : 0.0),
       view_format(source.negotiate(compositor.wanted_view_format(info.view))),
       queue(queue_capacity),
       decoder([this] { decode_loop(source, queue); }),
@@ -118,6 +121,7 @@ void PlaySession::wait_for_next_refresh() {
 }
 
 PlayResult PlaySession::finish(std::int64_t composited_ahead) {
+  source.interrupt();
   queue.stop();
   decoder.join();
   PlayResult result;

@@ -65,11 +65,16 @@ struct PlaySession {
   const ViewFormat view_format;  // negotiated before the first frame is decoded
   FrameQueue queue;
   std::jthread decoder;
-  // Unblocks the decoder before it is joined, however play ends.
+  // Unblocks the decoder before it is joined, however play ends (a live source may be waiting for
+  // a frame).
   struct StopDecoder {
     FrameQueue& queue;
-    ~StopDecoder() { queue.stop(); }
-  } stop_decoder{queue};
+    Source& source;
+    ~StopDecoder() {
+      source.interrupt();
+      queue.stop();
+    }
+  } stop_decoder{queue, source};
   PlayState state;
   PlayCommands commands;
   RenderTime render_time;  // the first render, which compiles shaders, does not count

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/frame_stamp.hpp"
 #include "core/user_error.hpp"
 
 namespace nelf::playback {
@@ -35,6 +36,10 @@ Refresh choose_frame(PlaySession& s) {
   // later than its sound (mkv: video at 0.023 s, audio at 0) would wait for it for ever. The
   // first frame is the poster shown while the clock waits, whenever its pts.
   if (!state.started && !r.queued.empty()) visible_at = std::max(visible_at, r.queued.front());
+  // A live source (a game's window) is shown as it comes: the newest frame read is due now, the
+  // older ones are dropped, whatever the clock says (its frames are made in real time, they are
+  // never early).
+  if (s.info.live && !r.queued.empty()) visible_at = std::max(visible_at, r.queued.back());
   const FrameDecision d = s.scheduler.decide(visible_at, r.queued, end);
   if (d.drop > 0 || d.show_front) {
     if (auto frame = s.queue.pop(d.drop, d.show_front)) {
@@ -71,6 +76,7 @@ void present_frame(PlaySession& s, Refresh& r) {
     throw UserError(fmt::format("the display was lost: {}", e.what()), 1);
   }
   r.present_s = seconds_since(t);
+  r.presented_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(Steady::now().time_since_epoch()).count();
   state.dirty = false;
   if (state.started) s.render_time.add(seconds_since(r.decided_at));
   if (!state.started) {
@@ -82,9 +88,19 @@ void present_frame(PlaySession& s, Refresh& r) {
 
 void log_refresh(PlaySession& s, std::int64_t index, const Refresh& r) {
   if (!r.event) return;
-  s.log.write(index, r.event, s.state.current ? std::optional(s.state.current->pts_s) : std::nullopt, s.clock.now(),
+  const FrameCompositor::Frame& current = s.state.current;
+  LiveFrameTimes live;
+  if (s.info.live && current) {
+    live.presented_ns = r.presented_ns;
+    live.captured_ns = current->captured_ns;
+    // A game that stamps its frames (tests/game/) says which one this is and when it presented it
+    // (its cells are fractions of the view: they read from block means too).
+    live.game = read_frame_stamp(current->left.data(), current->width / current->block[0],
+                                 current->height / current->block[1], current->bits);
+  }
+  s.log.write(index, r.event, current ? std::optional(current->pts_s) : std::nullopt, s.clock.now(),
               s.sound.output() ? std::optional(s.sound.output()->now()) : std::nullopt, s.scheduler.counters(),
-              r.upload_s, r.render_s, r.present_s, r.queued.size(), r.ahead);
+              r.upload_s, r.render_s, r.present_s, r.queued.size(), r.ahead, live);
 }
 
 // Not the frames whose time will have passed by the next refresh (it drops them): after a slow

@@ -17,6 +17,7 @@ struct Refresh {
   bool finished = false;        // the last frame has had its time: play is over
   bool ahead = false;           // the frame rendered was composited ahead by the worker
   double upload_s = 0.0, render_s = 0.0, present_s = 0.0;
+  std::int64_t presented_ns = 0;  // CLOCK_MONOTONIC once presented (0: nothing presented)
 };
 
 // Which frame this refresh shows, as the scheduler decides on the master clock: it is taken from

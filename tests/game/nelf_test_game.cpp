@@ -6,12 +6,15 @@
 //
 //   nelf-test-game [--toolkit glfw|sdl2] [--mode sbs|sbs-half|tab|tab-half|fp|quad-buffer]
 //                  [--fps N] [--size WxH] [--frames N] [--duration S] [--title T] [--log FILE]
+//                  [--reopen-after N] [--exit-status N]
 //
 // --size is one eye's size (default 1280x720); the window is sized from it and the mode (fp: the
 // frame-packed window of that eye size, 1280x720 → 1280x1470). The game follows its window's size
 // when it is resized. It ends after --frames or --duration, when its window is closed, or on
 // SIGINT/SIGTERM, with status 0; bad options end it with status 2. --log writes "frame,present_ns"
-// for every frame presented.
+// for every frame presented. --reopen-after N closes the window after N frames and opens a new
+// one, as games do for a splash screen or a new video mode; --exit-status N is the status it ends
+// with (after --frames or --duration), for the tests of `nelf run`.
 // epoxy before the toolkits' headers, which would include GL/gl.h.
 #include <epoxy/gl.h>
 
@@ -53,6 +56,8 @@ struct Options {
   double duration_s = 0;  // 0: no limit
   std::string title;
   std::string log;
+  long reopen_after = 0;  // 0: never
+  int exit_status = 0;
 };
 
 class BadUsage : public std::runtime_error {
@@ -122,10 +127,19 @@ Options parse(int argc, char** argv) {
       o.title = value();
     } else if (a == "--log") {
       o.log = value();
+    } else if (a == "--reopen-after") {
+      const double v = number(a, value());
+      if (v < 1 || v != std::floor(v)) throw BadUsage("--reopen-after must be a whole number ≥ 1");
+      o.reopen_after = static_cast<long>(v);
+    } else if (a == "--exit-status") {
+      const double v = number(a, value());
+      if (v < 0 || v > 125 || v != std::floor(v)) throw BadUsage("--exit-status must be 0..125");
+      o.exit_status = static_cast<int>(v);
     } else if (a == "--help" || a == "-h") {
       std::puts(
           "nelf-test-game [--toolkit glfw|sdl2] [--mode sbs|sbs-half|tab|tab-half|fp|quad-buffer] [--fps N]\n"
-          "               [--size WxH] [--frames N] [--duration S] [--title T] [--log FILE]");
+          "               [--size WxH] [--frames N] [--duration S] [--title T] [--log FILE]\n"
+          "               [--reopen-after N] [--exit-status N]");
       std::exit(0);
     } else {
       throw BadUsage("unknown option '" + a + "' (--help lists them)");
@@ -329,11 +343,15 @@ int run(const Options& o) {
   int w = 0, h = 0;
   window_size(o, w, h);
   std::unique_ptr<GameWindow> window;
-  if (o.toolkit == Toolkit::glfw)
-    window = std::make_unique<GlfwGameWindow>(o, w, h);
-  else
-    window = std::make_unique<SdlGameWindow>(o, w, h);
-  glEnable(GL_SCISSOR_TEST);
+  const auto open_window = [&] {
+    window.reset();  // the old one first: its toolkit is shut down and started again
+    if (o.toolkit == Toolkit::glfw)
+      window = std::make_unique<GlfwGameWindow>(o, w, h);
+    else
+      window = std::make_unique<SdlGameWindow>(o, w, h);
+    glEnable(GL_SCISSOR_TEST);
+  };
+  open_window();
   const auto period = static_cast<std::int64_t>(std::llround(1e9 / o.fps));
   const std::int64_t start = now_ns();
   std::int64_t deadline = start;
@@ -341,6 +359,10 @@ int run(const Options& o) {
     if (o.frames && frame >= o.frames) break;
     if (o.duration_s > 0 && static_cast<double>(now_ns() - start) >= o.duration_s * 1e9) break;
     if (window->closed()) break;
+    if (o.reopen_after && frame == o.reopen_after) {
+      window_size(o, w, h);
+      open_window();
+    }
     window->framebuffer_size(w, h);
     Rect left{}, right{};
     eye_rects(o.mode, w, h, left, right);
@@ -356,7 +378,7 @@ int run(const Options& o) {
     if (now > deadline + period) deadline = now;  // fell behind: skip ahead rather than burst
     sleep_until_ns(deadline);
   }
-  return 0;
+  return g_stop ? 0 : o.exit_status;
 }
 
 }  // namespace

@@ -284,7 +284,7 @@ TEST_F(VideoSourceTest, AppliesRotationLikeFfmpegsAutorotate) {
   }
 
   // Without rotation the frame comes as stored: red on the top left.
-  const VideoFrame as_stored = first_frame(rotated, VideoSourceOptions{.apply_rotation = false});
+  const VideoFrame as_stored = first_frame(rotated, VideoSourceOptions{.apply_rotation = false, .device = {}});
   EXPECT_EQ(as_stored.width, 64);
   EXPECT_EQ(as_stored.height, 36);
   EXPECT_GT(as_stored.channel(8, 4, 0), 0.9f);

@@ -1,0 +1,76 @@
+#include "player/game_process.hpp"
+
+#include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <thread>
+
+#include "core/printable.hpp"
+#include "core/user_error.hpp"
+
+extern char** environ;
+
+namespace nelf {
+
+GameProcess::GameProcess(const std::vector<std::string>& command) {
+  if (command.empty()) throw UserError("nelf run needs the game to start: nelf run [options] -- GAME [ARGS...]", 2);
+  name_ = command.front();
+  std::vector<char*> argv;
+  for (const std::string& arg : command) argv.push_back(const_cast<char*>(arg.c_str()));
+  argv.push_back(nullptr);
+  // The game keeps nelf's process group, so that Ctrl-C in the terminal reaches both, as the
+  // user expects of a program started from a shell; nelf's signal handlers are not inherited
+  // (posix_spawn resets handled signals to their defaults).
+  // nelf ignores SIGPIPE (it reports a closed pipe as an error); a game gets it back.
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t defaults;
+  sigemptyset(&defaults);
+  sigaddset(&defaults, SIGPIPE);
+  posix_spawnattr_setsigdefault(&attributes, &defaults);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF);
+  const int failed = posix_spawnp(&pid_, argv[0], nullptr, &attributes, argv.data(), environ);
+  posix_spawnattr_destroy(&attributes);
+  if (failed != 0) {
+    pid_ = -1;
+    throw UserError(fmt::format("{}: cannot start it: {}", printable(name_), std::strerror(failed)), 127);
+  }
+}
+
+GameProcess::~GameProcess() {
+  if (pid_ > 0 && !status_) end();
+}
+
+std::optional<int> GameProcess::exit_status(std::chrono::milliseconds wait) {
+  if (status_ || pid_ <= 0) return status_;
+  const auto until = std::chrono::steady_clock::now() + wait;
+  for (;;) {
+    int raw = 0;
+    const pid_t done = ::waitpid(pid_, &raw, WNOHANG);
+    if (done == pid_) {
+      status_ = WIFEXITED(raw) ? WEXITSTATUS(raw) : WIFSIGNALED(raw) ? 128 + WTERMSIG(raw) : 1;
+      return status_;
+    }
+    if (done < 0 && errno != EINTR) {
+      status_ = 1;  // not our child any more: nothing to wait for
+      return status_;
+    }
+    if (std::chrono::steady_clock::now() >= until) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+int GameProcess::end(std::chrono::milliseconds grace) {
+  if (const std::optional<int> ended = exit_status()) return *ended;
+  ::kill(pid_, SIGTERM);
+  if (const std::optional<int> ended = exit_status(grace)) return *ended;
+  ::kill(pid_, SIGKILL);
+  return exit_status(std::chrono::milliseconds(5000)).value_or(128 + SIGKILL);
+}
+
+}  // namespace nelf

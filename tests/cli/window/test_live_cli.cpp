@@ -1,0 +1,180 @@
+// Live games from the command line (private Xvfb, the test game): `nelf convert x11:window=…`
+// records what the HMD would show until --duration or Ctrl-C, with a complete file either way;
+// `nelf play x11:window=…` plays a window until it closes; `nelf run -- GAME` starts the game,
+// plays its window and ends with it, with its status; what cannot start is one line.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <thread>
+
+#include "support/test_game.hpp"
+#include "support/test_support.hpp"
+#include "support/xvfb.hpp"
+
+namespace nelf {
+namespace {
+
+using namespace std::chrono_literals;
+using test::run_command;
+using test::run_nelf;
+using test::shell_quote;
+
+class LiveCliTest : public ::testing::Test {
+ protected:
+  test::XvfbServer xvfb_;
+  test::ScopedDisplay display_env_{xvfb_.display_name()};
+  test::TempDir dir_;
+};
+
+TEST_F(LiveCliTest, ConvertRecordsAGameWindowForTheHmd) {
+  test::TestGame game({"--mode", "sbs", "--size", "320x180", "--fps", "30", "--title", "record me"});
+  const auto out = dir_.path() / "game.mkv";
+  const auto r = run_nelf("convert " + shell_quote("x11:wait=10,window=record me") + " " + shell_quote(out.string()) +
+                          " --duration 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("window 0x"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("layout sbs (aspect)"), std::string::npos) << r.err;
+  const std::string stream = run_command(
+                                 "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+                                 "stream=width,height,nb_read_frames -of csv=p=0 " +
+                                 shell_quote(out.string()))
+                                 .out;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(stream, m, std::regex("1280,1470,(\\d+)"))) << stream;  // hmz-t1: frame packing
+  EXPECT_GE(std::stoi(m[1]), 20) << "2 s of a 30 fps game";
+}
+
+TEST_F(LiveCliTest, CtrlCEndsARecordingWithACompleteFile) {
+  // --duration: were Ctrl-C missed, the test fails rather than waits for ever.
+  test::TestGame game({"--mode", "tab", "--size", "320x180", "--fps", "30", "--title", "stop me", "--duration", "60"});
+  const auto out = dir_.path() / "stopped.mkv";
+  const auto r =
+      run_command("( " + std::string(NELF_BINARY) + " convert " + shell_quote("x11:wait=10,window=stop me") + " " +
+                  shell_quote(out.string()) + " & pid=$!; sleep 3; kill -INT $pid; wait $pid; echo status=$? )");
+  EXPECT_NE(r.out.find("status=0"), std::string::npos) << r.out << r.err;
+  EXPECT_NE(r.err.find("layout tab (aspect)"), std::string::npos) << r.err;
+  ASSERT_TRUE(std::filesystem::exists(out)) << r.err;
+  const auto decoded = run_command("ffmpeg -v error -i " + shell_quote(out.string()) + " -f null -");
+  EXPECT_EQ(decoded.status, 0);
+  EXPECT_EQ(decoded.err, "") << "every frame decodes";
+  const auto frames = run_command(
+      "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+      "stream=nb_read_frames -of csv=p=0 " +
+      shell_quote(out.string()));
+  EXPECT_GE(std::stoi(frames.out), 10) << frames.out;
+}
+
+TEST_F(LiveCliTest, PlayShowsAWindowUntilItCloses) {
+  test::TestGame game({"--mode", "sbs", "--size", "320x180", "--fps", "30", "--duration", "6", "--title", "watch me"});
+  const auto log = dir_.path() / "frames.csv";
+  const auto r = run_nelf("play " + shell_quote("x11:wait=10,window=watch me") + " --output offscreen --log-frames " +
+                          shell_quote(log.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m, std::regex("(\\d+) frames shown"))) << r.err;
+  EXPECT_GE(std::stoi(m[1]), 5) << r.err;  // the player starts in ~1 s on two loaded software cores
+  EXPECT_TRUE(game.wait_exit(5s));
+}
+
+TEST_F(LiveCliTest, RunStartsTheGamePlaysItsWindowAndEndsWithIt) {
+  const auto log = dir_.path() / "frames.csv";
+  const auto r = run_nelf("run --output offscreen --log-frames " + shell_quote(log.string()) + " -- " +
+                          shell_quote(NELF_TEST_GAME) + " --mode sbs --size 320x180 --fps 30 --duration 6");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("\"nelf test game sbs\""), std::string::npos) << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m, std::regex("(\\d+) frames shown"))) << r.err;
+  EXPECT_GE(std::stoi(m[1]), 5) << r.err;  // the player starts in ~1 s on two loaded software cores
+  // The game's own options after --, the layout nelf's (a 640x180 window read as half SBS).
+  const auto half = run_nelf("run --output offscreen --layout sbs-half -- " + shell_quote(NELF_TEST_GAME) +
+                             " --mode sbs-half --size 320x180 --fps 30 --duration 1");
+  ASSERT_EQ(half.status, 0) << half.err;
+  EXPECT_NE(half.err.find("two 160x180 views, layout sbs-half (flag)"), std::string::npos) << half.err;
+}
+
+TEST_F(LiveCliTest, FfmpegCaptureDevicesAreInputsToo) {
+  // lavfi: a filter graph read as a device; x11grab: FFmpeg's own screen grabber on this Xvfb.
+  const auto graph = dir_.path() / "graph.mkv";
+  const auto r = run_nelf("convert " + shell_quote("device:lavfi:testsrc2=size=640x180:rate=30") + " " +
+                          shell_quote(graph.string()) + " --duration 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("layout sbs (aspect)"), std::string::npos) << r.err;
+  const auto frames = [](const std::filesystem::path& file) {
+    return run_command(
+               "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+               "stream=width,height,nb_read_frames -of csv=p=0 " +
+               shell_quote(file.string()))
+        .out;
+  };
+  EXPECT_EQ(frames(graph), "1280,1470,30\n");
+  const auto screen = dir_.path() / "screen.mkv";
+  const auto grabbed = run_nelf("convert " + shell_quote("device:x11grab:" + xvfb_.display_name()) + " " +
+                                shell_quote(screen.string()) + " --layout mono --frames 5");
+  ASSERT_EQ(grabbed.status, 0) << grabbed.err;
+  EXPECT_EQ(frames(screen), "1280,1470,5\n");
+}
+
+TEST_F(LiveCliTest, ProbeSaysItDescribesFiles) {
+  test::expect_clean_failure(dir_, "probe x11:window=anything", 2,
+                             "probe describes media files; a live input is described by play and convert");
+  test::expect_clean_failure(dir_, "probe device:lavfi:testsrc2", 2, "probe describes media files");
+}
+
+TEST_F(LiveCliTest, RunFollowsTheGameToItsNextWindow) {
+  // A splash window first, then the game's: both are played, and the game's status is nelf's.
+  const auto r = run_nelf("run --output offscreen -- " + shell_quote(NELF_TEST_GAME) +
+                          " --mode sbs --size 320x180 --fps 30 --reopen-after 60 --frames 150 --exit-status 7");
+  EXPECT_EQ(r.status, 7) << r.err;
+  EXPECT_NE(r.err.find("the game's window closed; waiting for its next one"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("exited with status 7"), std::string::npos) << r.err;
+  std::smatch m;
+  std::string rest = r.err;
+  int plays = 0;
+  while (std::regex_search(rest, m, std::regex("(\\d+) frames shown"))) {
+    ++plays;
+    // Each window is a new start of the player (shaders, tables): on two software cores that
+    // takes most of a second, so only a part of the window's 2 or 3 s is shown.
+    EXPECT_GE(std::stoi(m[1]), 2) << r.err;
+    rest = m.suffix();
+  }
+  EXPECT_EQ(plays, 2) << r.err;
+}
+
+TEST_F(LiveCliTest, RunEndsWithTheGamesStatus) {
+  const auto r = run_nelf("run --output offscreen -- sh -c 'exit 3'");
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("ended without opening a window (the game exited with status 3)"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  const auto missing = run_nelf("run --output offscreen -- /no/such/game");
+  EXPECT_EQ(missing.status, 127);
+  EXPECT_NE(missing.err.find("/no/such/game: cannot start it"), std::string::npos) << missing.err;
+  const auto none = run_nelf("run --output offscreen");
+  EXPECT_EQ(none.status, 2);
+  EXPECT_NE(none.err.find("nelf run [options] -- GAME [ARGS...]"), std::string::npos) << none.err;
+}
+
+TEST_F(LiveCliTest, InterruptingRunEndsTheGameToo) {
+  const auto r =
+      run_command("( " + std::string(NELF_BINARY) + " run --output offscreen -- " + shell_quote(NELF_TEST_GAME) +
+                  " --mode sbs --size 320x180 --fps 30 --duration 60 & pid=$!; sleep 3; kill -INT $pid; wait $pid; "
+                  "echo status=$? )");
+  EXPECT_NE(r.out.find("status=130"), std::string::npos) << r.out << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m, std::regex("x11:pid=(\\d+)"))) << r.err;
+  EXPECT_FALSE(std::filesystem::exists("/proc/" + m[1].str())) << "the game was left running";
+  // Before the game has a window: nelf stops waiting for it and ends it.
+  const auto start = std::chrono::steady_clock::now();
+  const auto waiting = run_command("( " + std::string(NELF_BINARY) +
+                                   " run --output offscreen -- sleep 37.5 & pid=$!; sleep 1; kill -INT $pid; "
+                                   "wait $pid; echo status=$?; pgrep -f '^sleep 37.5$' || echo gone )");
+  EXPECT_NE(waiting.out.find("status=130"), std::string::npos) << waiting.out << waiting.err;
+  EXPECT_NE(waiting.out.find("gone"), std::string::npos) << waiting.out;
+  EXPECT_NE(waiting.err.find("interrupted while waiting for the window"), std::string::npos) << waiting.err;
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 10s);
+}
+
+}  // namespace
+}  // namespace nelf

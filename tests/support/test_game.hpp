@@ -1,0 +1,68 @@
+#pragma once
+// The test game (tests/game/) started for a test: its own process with the given arguments, in
+// the test's DISPLAY, ended (SIGTERM, then SIGKILL) and reaped when the test is done with it.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace nelf::test {
+
+class TestGame {
+ public:
+  explicit TestGame(const std::vector<std::string>& args) {
+    std::vector<std::string> all{NELF_TEST_GAME};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_ = fork();
+    if (pid_ < 0) throw std::runtime_error("fork failed");
+    if (pid_ == 0) {
+      execv(argv[0], argv.data());
+      _exit(127);
+    }
+  }
+  ~TestGame() {
+    if (pid_ <= 0 || exited_) return;
+    kill(pid_, SIGTERM);
+    for (int i = 0; i < 200 && !wait_exit(std::chrono::milliseconds(10)); ++i) {
+    }
+    if (!exited_) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  TestGame(const TestGame&) = delete;
+  TestGame& operator=(const TestGame&) = delete;
+
+  pid_t pid() const { return pid_; }
+  // True once the game has ended (within `wait`); its status in status().
+  bool wait_exit(std::chrono::milliseconds wait) {
+    const auto until = std::chrono::steady_clock::now() + wait;
+    while (!exited_) {
+      int raw = 0;
+      if (waitpid(pid_, &raw, WNOHANG) == pid_) {
+        exited_ = true;
+        status_ = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+        break;
+      }
+      if (std::chrono::steady_clock::now() >= until) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return exited_;
+  }
+  int status() const { return status_; }
+
+ private:
+  pid_t pid_ = -1;
+  bool exited_ = false;
+  int status_ = -1;
+};
+
+}  // namespace nelf::test
