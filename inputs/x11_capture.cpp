@@ -297,7 +297,6 @@ struct X11Capture::State {
   }
 
   CapturedImage read_now() {
-    if (resized) prepare();
     // The notices of changes so far (all queued once XSync returns) are for what this read shows:
     // dropped. The damage is emptied again just before the read, without looking: Damage notices
     // only when it goes from empty to not, so a change between the two would otherwise leave it

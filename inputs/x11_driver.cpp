@@ -5,16 +5,13 @@
 // (swscale), so that the stream keeps one geometry, as a recording must.
 #include <fmt/format.h>
 
-extern "C" {
-#include <libswscale/swscale.h>
-}
-
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstring>
 #include <memory>
 
+#include "core/ffmpeg_raii.hpp"
 #include "core/printable.hpp"
 #include "core/user_error.hpp"
 #include "inputs/source.hpp"
@@ -24,10 +21,6 @@ extern "C" {
 
 namespace nelf::drivers {
 namespace {
-
-struct ScalerFree {
-  void operator()(SwsContext* c) const { sws_freeContext(c); }
-};
 
 // `rect` of the image as (width / bx) × (height / by) means of bx × by pixels (1 × 1: a copy), the
 // ViewFormat the compositor negotiated: the compositor's first prefilter pass done while the
@@ -166,7 +159,7 @@ class X11FrameSource final : public Source {
   std::string description_;
   std::atomic<bool> interrupted_{false};
   std::array<int, 2> block_{1, 1};  // what negotiate() set
-  std::unique_ptr<SwsContext, ScalerFree> scaler_;
+  ffmpeg::SwsContextPtr scaler_;
   std::pair<int, int> scaled_from_{0, 0};
 };
 

@@ -87,7 +87,7 @@ void present_frame(PlaySession& s, Refresh& r) {
 }
 
 void log_refresh(PlaySession& s, std::int64_t index, const Refresh& r) {
-  if (!r.event) return;
+  if (!r.event || !s.log.enabled()) return;  // no stamp read on a refresh nobody logs
   const FrameCompositor::Frame& current = s.state.current;
   LiveFrameTimes live;
   if (s.info.live && current) {
