@@ -8,24 +8,20 @@
 #include "core/user_error.hpp"
 #include "inputs/source_drivers.hpp"
 #include "inputs/video_source.hpp"
+#include "support/source_requests.hpp"
 
 namespace nelf {
 namespace {
 
-SourceRequest device_request(const std::string& input) {
-  SourceRequest r;
-  r.input = input;
-  r.quiet = true;
-  return r;
-}
+using test::quiet_request;
 
 const std::string kTestDevice = "device:lavfi:testsrc2=size=640x180:rate=30";
 
 TEST(DeviceSource, ALavfiGraphIsALiveSideBySideInput) {
   quiet_ffmpeg_logs(true);
-  EXPECT_EQ(source_driver_for(device_request(kTestDevice)).name, "device");
-  EXPECT_EQ(source_driver_for(device_request("v4l2:/dev/video0")).name, "device");
-  const auto source = open_source(device_request(kTestDevice));
+  EXPECT_EQ(source_driver_for(quiet_request(kTestDevice)).name, "device");
+  EXPECT_EQ(source_driver_for(quiet_request("v4l2:/dev/video0")).name, "device");
+  const auto source = open_source(quiet_request(kTestDevice));
   const SourceInfo info = source->info();
   EXPECT_TRUE(info.live);
   EXPECT_FALSE(info.seekable);
@@ -54,7 +50,7 @@ TEST(DeviceSource, ALavfiGraphIsALiveSideBySideInput) {
 
 TEST(DeviceSource, InterruptEndsIt) {
   quiet_ffmpeg_logs(true);
-  const auto source = open_source(device_request(kTestDevice));
+  const auto source = open_source(quiet_request(kTestDevice));
   ASSERT_TRUE(source->next());
   source->interrupt();
   EXPECT_FALSE(source->next());
@@ -81,7 +77,7 @@ TEST(DeviceSource, BadNamesAreOneLineNamingTheInput) {
       {kTestDevice, 2, "layout pair needs two files", StereoLayout::pair},
   };
   for (const Case& c : cases) {
-    SourceRequest r = device_request(c.input);
+    SourceRequest r = quiet_request(c.input);
     r.layout = c.layout;
     r.start_s = c.start;
     r.right = c.layout ? "right.mkv" : "";

@@ -6,14 +6,13 @@
 #include "inputs/estimated_depth_source.hpp"
 #include "inputs/source_drivers.hpp"
 #include "inputs/synthetic_source.hpp"
+#include "support/source_requests.hpp"
 
 namespace nelf {
 namespace {
 
 SourceRequest planes(bool known_depth, std::shared_ptr<const Profile> display = nullptr) {
-  SourceRequest r;
-  r.input = "synthetic:scene=planes,duration=0.25,size=320x180";
-  r.quiet = true;
+  SourceRequest r = test::quiet_request("synthetic:scene=planes,duration=0.25,size=320x180");
   r.known_depth = known_depth;
   r.display = std::move(display);
   return r;

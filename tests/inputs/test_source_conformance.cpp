@@ -15,6 +15,7 @@
 #include "inputs/video_source.hpp"
 #include "support/image_files.hpp"
 #include "support/media.hpp"
+#include "support/source_requests.hpp"
 #include "support/test_support.hpp"
 
 namespace nelf {
@@ -22,13 +23,7 @@ namespace {
 
 using test::TempDir;
 
-SourceRequest request_for(const std::string& input, std::optional<StereoLayout> layout = std::nullopt) {
-  SourceRequest request;
-  request.input = input;
-  request.layout = layout;
-  request.quiet = true;
-  return request;
-}
+using test::quiet_request;
 
 // A good input and a bad one for a driver, made in `dir`; `bad_status` is the status its error has.
 struct DriverInputs {
@@ -40,13 +35,13 @@ const std::map<std::string, std::function<DriverInputs(const TempDir&)>>& input_
   static const std::map<std::string, std::function<DriverInputs(const TempDir&)>> makers = {
       {"synthetic",
        [](const TempDir&) {
-         return DriverInputs{request_for("synthetic:duration=0.5,size=64x36,fps=10"), request_for("synthetic:fps=0"),
-                             2};
+         return DriverInputs{quiet_request("synthetic:duration=0.5,size=64x36,fps=10"),
+                             quiet_request("synthetic:fps=0"), 2};
        }},
       {"device",
        [](const TempDir&) {
-         return DriverInputs{request_for("device:lavfi:testsrc2=size=64x36:rate=10,trim=duration=1"),
-                             request_for("device:nosuch:x"), 1};
+         return DriverInputs{quiet_request("device:lavfi:testsrc2=size=64x36:rate=10,trim=duration=1"),
+                             quiet_request("device:nosuch:x"), 1};
        }},
       {"still",
        [](const TempDir& dir) {
@@ -55,15 +50,15 @@ const std::map<std::string, std::function<DriverInputs(const TempDir&)>>& input_
            for (int x = 32; x < 64; ++x) sbs.at(x, y) = {0.1f, 0.2f, 0.7f, 1.f};
          test::write_test_image(dir / "photo.jps", sbs, 3, OIIO::TypeDesc::UINT8, "jpeg");
          test::write_file(dir / "cut.jpg", test::read_file(dir / "photo.jps").substr(0, 40));
-         return DriverInputs{request_for((dir / "photo.jps").string()), request_for((dir / "cut.jpg").string()), 1};
+         return DriverInputs{quiet_request((dir / "photo.jps").string()), quiet_request((dir / "cut.jpg").string()), 1};
        }},
       {"file",
        [](const TempDir& dir) {
          const auto clip = test::make_media(
              dir / "sbs.mkv", test::two_colour_input(64, 36, false, 20, 10) + " -c:v ffv1 -pix_fmt yuv420p");
          test::write_file(dir / "notes.txt", "not a video\n");
-         return DriverInputs{request_for(clip.string(), StereoLayout::sbs), request_for((dir / "notes.txt").string()),
-                             1};
+         return DriverInputs{quiet_request(clip.string(), StereoLayout::sbs),
+                             quiet_request((dir / "notes.txt").string()), 1};
        }},
   };
   return makers;

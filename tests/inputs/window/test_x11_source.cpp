@@ -15,6 +15,7 @@
 #include "core/frame_stamp.hpp"
 #include "core/user_error.hpp"
 #include "inputs/source_drivers.hpp"
+#include "support/source_requests.hpp"
 #include "support/test_game.hpp"
 #include "support/xvfb.hpp"
 
@@ -32,13 +33,7 @@ std::int64_t monotonic_ns() {
   return static_cast<std::int64_t>(t.tv_sec) * 1000000000 + t.tv_nsec;
 }
 
-SourceRequest capture_request(const std::string& input, std::optional<StereoLayout> layout = std::nullopt) {
-  SourceRequest r;
-  r.input = input;
-  r.layout = layout;
-  r.quiet = true;
-  return r;
-}
+using test::quiet_request;
 
 struct Stamps {
   FrameStamp left, right;
@@ -78,7 +73,7 @@ TEST_F(X11SourceTest, EachLayoutTheGameDrawsGivesItsTwoViewsFrameAfterFrame) {
     std::vector<std::string> args{"--mode", c.mode, "--fps", "30", "--title", title};
     args.insert(args.end(), c.size.begin(), c.size.end());
     test::TestGame game(args);
-    auto source = open_source(capture_request("x11:wait=10,window=" + title, c.flag));
+    auto source = open_source(quiet_request("x11:wait=10,window=" + title, c.flag));
     const SourceInfo info = source->info();
     EXPECT_TRUE(info.live);
     EXPECT_FALSE(info.seekable);
@@ -127,7 +122,7 @@ TEST_F(X11SourceTest, EachLayoutTheGameDrawsGivesItsTwoViewsFrameAfterFrame) {
 
 TEST_F(X11SourceTest, ViewsComeAsTheBlockMeansTheCompositorAsksFor) {
   test::TestGame game({"--mode", "sbs", "--size", "640x360", "--title", "block game"});
-  auto source = open_source(capture_request("x11:wait=10,window=block game"));
+  auto source = open_source(quiet_request("x11:wait=10,window=block game"));
   EXPECT_EQ(source->negotiate({{2, 3}}), (ViewFormat{{2, 3}}));  // 320x120 means of each view
   int stamped = 0;
   for (int i = 0; i < 8; ++i) {
@@ -153,7 +148,7 @@ TEST_F(X11SourceTest, ViewsComeAsTheBlockMeansTheCompositorAsksFor) {
 
 TEST_F(X11SourceTest, SwappedEyesAreExchanged) {
   test::TestGame game({"--mode", "sbs", "--size", "320x180", "--title", "swap game"});
-  SourceRequest r = capture_request("x11:wait=10,window=swap game");
+  SourceRequest r = quiet_request("x11:wait=10,window=swap game");
   r.swap_eyes = true;
   auto source = open_source(r);
   EXPECT_NE(source->info().description.find("layout sbs swapped"), std::string::npos) << source->info().description;
@@ -161,7 +156,7 @@ TEST_F(X11SourceTest, SwappedEyesAreExchanged) {
 
 TEST_F(X11SourceTest, AResizedWindowIsScaledToItsFirstSize) {
   test::TestGame game({"--mode", "sbs", "--size", "320x180", "--title", "resize game"});
-  auto source = open_source(capture_request("x11:wait=10,window=resize game"));
+  auto source = open_source(quiet_request("x11:wait=10,window=resize game"));
   const std::string description = source->info().description;
   const std::size_t at = description.find("window 0x");
   ASSERT_NE(at, std::string::npos);
@@ -184,7 +179,7 @@ TEST_F(X11SourceTest, AResizedWindowIsScaledToItsFirstSize) {
 
 TEST_F(X11SourceTest, TheSourceEndsWhenTheWindowCloses) {
   test::TestGame game({"--mode", "sbs", "--size", "320x180", "--title", "short game", "--frames", "20"});
-  auto source = open_source(capture_request("x11:wait=10,window=short game"));
+  auto source = open_source(quiet_request("x11:wait=10,window=short game"));
   int frames = 0;
   const auto start = std::chrono::steady_clock::now();
   while (source->next()) ++frames;
@@ -202,7 +197,7 @@ TEST_F(X11SourceTest, InterruptEndsAWaitForAWindowThatNeverChanges) {
   XMapWindow(d, w);
   XSync(d, False);
   {
-    auto source = open_source(capture_request("x11:wait=5,window=still window", StereoLayout::sbs));
+    auto source = open_source(quiet_request("x11:wait=5,window=still window", StereoLayout::sbs));
     ASSERT_TRUE(source->next());  // what it shows now
     std::atomic<bool> returned{false};
     std::optional<StereoVideoFrame> second;
@@ -237,10 +232,10 @@ TEST_F(X11SourceTest, SeveralMatchesAreListedToChooseOne) {
   test::TestGame a({"--mode", "sbs", "--size", "320x180", "--title", "twin game A"});
   test::TestGame b({"--mode", "sbs", "--size", "320x180", "--title", "twin game B"});
   // Both windows there first.
-  open_source(capture_request("x11:wait=10,window=twin game A"));
-  open_source(capture_request("x11:wait=10,window=twin game B"));
+  open_source(quiet_request("x11:wait=10,window=twin game A"));
+  open_source(quiet_request("x11:wait=10,window=twin game B"));
   std::string message;
-  EXPECT_EQ(status_of(capture_request("x11:window=twin game"), message), 2);
+  EXPECT_EQ(status_of(quiet_request("x11:window=twin game"), message), 2);
   EXPECT_NE(message.find("matches 2 windows"), std::string::npos) << message;
   EXPECT_NE(message.find("\"twin game A\" 640x180"), std::string::npos) << message;
   EXPECT_NE(message.find("\"twin game B\" 640x180"), std::string::npos) << message;
@@ -250,25 +245,25 @@ TEST_F(X11SourceTest, SeveralMatchesAreListedToChooseOne) {
 
 TEST_F(X11SourceTest, WhatFindsNoWindowIsOneLine) {
   std::string message;
-  EXPECT_EQ(status_of(capture_request("x11:window=no such game"), message), 1);
+  EXPECT_EQ(status_of(quiet_request("x11:window=no such game"), message), 1);
   EXPECT_NE(message.find("no window on display"), std::string::npos) << message;
-  EXPECT_EQ(status_of(capture_request("x11:window-id=0x7ffffff"), message), 1);
+  EXPECT_EQ(status_of(quiet_request("x11:window-id=0x7ffffff"), message), 1);
   EXPECT_NE(message.find("no window 0x7ffffff"), std::string::npos) << message;
-  EXPECT_EQ(status_of(capture_request("x11:display=:9999"), message), 1);
+  EXPECT_EQ(status_of(quiet_request("x11:display=:9999"), message), 1);
   EXPECT_NE(message.find("cannot open display :9999"), std::string::npos) << message;
   {
     test::ScopedDisplay none("");
-    EXPECT_EQ(status_of(capture_request("x11:"), message), 1);
+    EXPECT_EQ(status_of(quiet_request("x11:"), message), 1);
     EXPECT_NE(message.find("DISPLAY is not set"), std::string::npos) << message;
   }
-  EXPECT_EQ(status_of(capture_request("x11:window=anything", StereoLayout::alt), message), 2);
+  EXPECT_EQ(status_of(quiet_request("x11:window=anything", StereoLayout::alt), message), 2);
   EXPECT_NE(message.find("layout alt needs a file"), std::string::npos) << message;
 }
 
 TEST_F(X11SourceTest, TheScreenIsASourceToo) {
   test::TestGame game({"--mode", "sbs", "--size", "320x180", "--title", "screen game"});
-  open_source(capture_request("x11:wait=10,window=screen game"));
-  auto source = open_source(capture_request("x11:"));
+  open_source(quiet_request("x11:wait=10,window=screen game"));
+  auto source = open_source(quiet_request("x11:"));
   EXPECT_EQ(source->info().view.width, 2600);
   EXPECT_EQ(source->info().view.height, 1600);  // 1.6:1: mono, with a warning
   int frames = 0;
