@@ -1,5 +1,7 @@
 #include "core/carried_streams.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <new>
 
 namespace nelf {
@@ -37,6 +39,24 @@ CarriedStreamLayout describe_carried_streams(const AVFormatContext& input) {
   }
   layout.metadata = copy_dictionary(input.metadata);
   return layout;
+}
+
+std::vector<CarriedChapter> chapters_in_range(std::vector<CarriedChapter> chapters, double origin_s,
+                                              std::optional<double> end_s) {
+  std::vector<CarriedChapter> kept;
+  for (CarriedChapter& chapter : chapters) {
+    const double unit = av_q2d(chapter.time_base);
+    if (unit <= 0.0) continue;
+    const double start = static_cast<double>(chapter.start) * unit - origin_s;
+    double end = static_cast<double>(chapter.end) * unit - origin_s;
+    if (end_s) end = std::min(end, *end_s);
+    // A chapter that ends at the start point (or begins at the end) is not in the range.
+    if (end <= std::max(start, 0.0) + 1e-6) continue;
+    chapter.start = std::llround(std::max(start, 0.0) / unit);
+    chapter.end = std::llround(end / unit);
+    kept.push_back(std::move(chapter));
+  }
+  return kept;
 }
 
 }  // namespace nelf

@@ -38,6 +38,13 @@ struct CarriedStreamLayout {
 // outlive it.
 CarriedStreamLayout describe_carried_streams(const AVFormatContext& input);
 
+// The chapters of a conversion that starts at input time `origin_s` and ends at output time
+// `end_s` (nullopt: the input's end): shifted to output time, those wholly outside left out, the
+// others cut to the range (a chapter running at the start point starts at 0), as a player would
+// show them in the output.
+std::vector<CarriedChapter> chapters_in_range(std::vector<CarriedChapter> chapters, double origin_s,
+                                              std::optional<double> end_s);
+
 class CarriedStreams {
  public:
   virtual ~CarriedStreams() = default;
@@ -45,8 +52,9 @@ class CarriedStreams {
   // The next packet, in file order, of the streams in `wanted` (CarriedStream::index) that starts
   // at or before output time `until_s` (any time when nullopt), with its timestamps in its
   // stream's time base shifted to output time (0: the video's first frame). Packets before 0 or
-  // at or after `end_s` are left out. Null when the next wanted packet is later than `until_s`
-  // (it is kept for a later call) or the input has no more.
+  // at or after `end_s` are left out, and so is audio that would play past `end_s`; a subtitle
+  // event is cut to [0, end_s) instead (one on screen at 0 starts there). Null when the next
+  // wanted packet is later than `until_s` (it is kept for a later call) or the input has no more.
   virtual ffmpeg::PacketPtr next_packet(std::span<const int> wanted, std::optional<double> until_s,
                                         std::optional<double> end_s) = 0;
 };

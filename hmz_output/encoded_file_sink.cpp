@@ -26,6 +26,7 @@ class EncodedFileSink final : public FrameSink {
         end_s_(r.duration_s) {
     EncoderSettings settings = r.encoder;
     settings.bits = r.bits;
+    settings.carried_end_s = r.duration_s;
     const AVRational rate = av_d2q(r.frame_rate, 100000);
     try {
       encoder_.emplace(r.output, r.width, r.height, rate.num, rate.den, settings,

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <stdexcept>
 #include <system_error>
@@ -216,6 +217,82 @@ struct ReencodedStream {
   std::unique_ptr<AudioTrack> track;
 };
 
+// A decoded subtitle event, freed with what the decoder allocated in it.
+struct DecodedSubtitle {
+  AVSubtitle subtitle{};
+  DecodedSubtitle() = default;
+  DecodedSubtitle(const DecodedSubtitle&) = delete;
+  DecodedSubtitle& operator=(const DecodedSubtitle&) = delete;
+  ~DecodedSubtitle() { avsubtitle_free(&subtitle); }
+};
+
+// A text subtitle stream (SubRip, ASS, WebVTT) for a container that holds only its own text
+// format (MP4, MOV: mov_text, the tx3g of QuickTime): each event is decoded to its ASS text and
+// encoded again, keeping its time. FFmpeg's own decoders and mov_text encoder do it, as the
+// ffmpeg CLI does for `-c:s mov_text`, so styling tags are mapped as it maps them.
+class TextSubtitleTrack {
+ public:
+  // Null when FFmpeg lacks the decoder or the encoder.
+  static std::unique_ptr<TextSubtitleTrack> open(AVFormatContext* muxer, const CarriedStream& in) {
+    const AVCodec* decoder = avcodec_find_decoder(in.codec->codec_id);
+    const AVCodec* encoder = avcodec_find_encoder(AV_CODEC_ID_MOV_TEXT);
+    if (!decoder || !encoder) return nullptr;
+    auto track = std::make_unique<TextSubtitleTrack>();
+    track->decoder_.reset(avcodec_alloc_context3(decoder));
+    if (!track->decoder_ || avcodec_parameters_to_context(track->decoder_.get(), in.codec.get()) < 0) return nullptr;
+    track->decoder_->pkt_timebase = in.time_base;
+    if (avcodec_open2(track->decoder_.get(), decoder, nullptr) < 0) return nullptr;
+    track->encoder_.reset(avcodec_alloc_context3(encoder));
+    if (!track->encoder_) return nullptr;
+    track->encoder_->time_base = in.time_base;
+    // The encoder reads the styles the decoder's events refer to from the decoder's ASS header.
+    if (const AVCodecContext& d = *track->decoder_; d.subtitle_header_size > 0) {
+      track->encoder_->subtitle_header = static_cast<uint8_t*>(av_mallocz(d.subtitle_header_size + 1));
+      if (!track->encoder_->subtitle_header) throw std::bad_alloc();
+      std::copy_n(d.subtitle_header, d.subtitle_header_size, track->encoder_->subtitle_header);
+      track->encoder_->subtitle_header_size = d.subtitle_header_size;
+    }
+    if (avcodec_open2(track->encoder_.get(), encoder, nullptr) < 0) return nullptr;
+    track->stream_ = avformat_new_stream(muxer, nullptr);
+    if (!track->stream_) throw std::bad_alloc();
+    avcodec_parameters_from_context(track->stream_->codecpar, track->encoder_.get());
+    track->stream_->time_base = in.time_base;
+    return track;
+  }
+
+  AVStream* stream() const { return stream_; }
+
+  // One source event; a damaged one is skipped.
+  void write(const AVPacket& in, const PacketWriter& write) {
+    DecodedSubtitle decoded;
+    int got = 0;
+    AVPacket* source = const_cast<AVPacket*>(&in);  // FFmpeg 5.1 takes a non-const packet
+    if (avcodec_decode_subtitle2(decoder_.get(), &decoded.subtitle, &got, source) < 0 || !got) return;
+    std::vector<uint8_t> buffer(std::max<std::size_t>(1024, static_cast<std::size_t>(in.size) * 4 + 64));
+    const int size =
+        avcodec_encode_subtitle(encoder_.get(), buffer.data(), static_cast<int>(buffer.size()), &decoded.subtitle);
+    if (size <= 0) return;
+    PacketPtr out(av_packet_alloc());
+    if (!out || av_new_packet(out.get(), size) < 0) throw std::bad_alloc();
+    std::copy_n(buffer.data(), size, out->data);
+    out->pts = in.pts;
+    out->dts = in.pts;
+    out->duration = in.duration;
+    out->flags |= AV_PKT_FLAG_KEY;
+    out->stream_index = stream_->index;
+    write(out.get(), encoder_->time_base);
+  }
+
+ private:
+  CodecContextPtr decoder_, encoder_;
+  AVStream* stream_ = nullptr;
+};
+
+bool is_text_subtitle(AVCodecID id) {
+  const AVCodecDescriptor* descriptor = avcodec_descriptor_get(id);
+  return descriptor && (descriptor->props & AV_CODEC_PROP_TEXT_SUB) != 0;
+}
+
 }  // namespace
 
 struct VideoEncoder::State {
@@ -233,7 +310,8 @@ struct VideoEncoder::State {
   bool header_written = false, finished = false;
   std::unique_ptr<AudioTrack> generated_audio;  // add_audio_track()
   int generated_channels = 0, generated_rate = 0;
-  std::vector<std::unique_ptr<ReencodedStream>> reencoded;  // by source stream index, null when copied/dropped
+  std::vector<std::unique_ptr<ReencodedStream>> reencoded;       // by source stream index, null when copied/dropped
+  std::vector<std::unique_ptr<TextSubtitleTrack>> retimed_text;  // by source stream index, null unless mov_text
   PacketWriter writer = [this](AVPacket* p, AVRational time_base) { write(p, time_base); };
   int64_t last_pts = AV_NOPTS_VALUE;
 
@@ -339,13 +417,30 @@ VideoEncoder::VideoEncoder(const std::filesystem::path& output, int width, int h
     const auto slots = static_cast<std::size_t>(last_index + 1);
     s.stream_map.assign(slots, -1);
     s.source_time_bases.assign(slots, AVRational{0, 1});
+    int subtitles = 0;
     for (const CarriedStream& in : carried->streams) {
       const auto i = static_cast<std::size_t>(in.index);
       s.source_time_bases[i] = in.time_base;
       const AVMediaType type = in.codec->codec_type;
       if (type == AVMEDIA_TYPE_AUDIO && !settings.audio) continue;
       if (type != AVMEDIA_TYPE_AUDIO && type != AVMEDIA_TYPE_SUBTITLE) continue;
-      if (avformat_query_codec(format, in.codec->codec_id, FF_COMPLIANCE_NORMAL) != 1) {
+      // A player draws a default subtitle track flat over the whole frame, across the elemental
+      // images of the right eye's half too: carried tracks are there to be chosen, not shown.
+      const int disposition = type == AVMEDIA_TYPE_SUBTITLE ? in.disposition & ~AV_DISPOSITION_DEFAULT : in.disposition;
+      const bool holds = avformat_query_codec(format, in.codec->codec_id, FF_COMPLIANCE_NORMAL) == 1;
+      if (!holds && type == AVMEDIA_TYPE_SUBTITLE && is_text_subtitle(in.codec->codec_id) &&
+          avformat_query_codec(format, AV_CODEC_ID_MOV_TEXT, FF_COMPLIANCE_NORMAL) == 1) {
+        if (auto text = TextSubtitleTrack::open(s.muxer.get(), in)) {
+          av_dict_copy(&text->stream()->metadata, in.metadata.get(), 0);
+          text->stream()->disposition = disposition;
+          s.stream_map[i] = text->stream()->index;
+          s.retimed_text.resize(slots);
+          s.retimed_text[i] = std::move(text);
+          ++subtitles;
+          continue;
+        }
+      }
+      if (!holds) {
         if (type == AVMEDIA_TYPE_AUDIO) {
           // The container cannot hold this audio codec: decode it and re-encode it as AAC.
           s.reencoded.resize(slots);
@@ -373,18 +468,41 @@ VideoEncoder::VideoEncoder(const std::filesystem::path& output, int width, int h
       avcodec_parameters_copy(out->codecpar, in.codec.get());
       out->codecpar->codec_tag = 0;
       out->time_base = in.time_base;
-      out->disposition = in.disposition;
+      out->disposition = disposition;
       av_dict_copy(&out->metadata, in.metadata.get(), 0);  // language tags, titles
       s.stream_map[i] = out->index;
+      if (type == AVMEDIA_TYPE_SUBTITLE) ++subtitles;
     }
+    // The MP4 muxer enables the first track of each kind when none is default (FFmpeg 5.1's
+    // enable_tracks), and players show an enabled subtitle track.
+    const bool enables_first = avformat_query_codec(format, AV_CODEC_ID_MOV_TEXT, FF_COMPLIANCE_NORMAL) == 1;
+    if (subtitles > 0)
+      fmt::print(stderr,
+                 "nelf: {} subtitle stream{} carried without the default flag: a player would draw {} flat across "
+                 "the elemental images of both eyes{}\n",
+                 subtitles, subtitles == 1 ? "" : "s", subtitles == 1 ? "it" : "them",
+                 enables_first
+                     ? fmt::format(" ({} enables the first one all the same; .mkv keeps them off)", format->name)
+                     : "");
     av_dict_copy(&s.muxer->metadata, carried->metadata.get(), 0);
-    if (!carried->chapters.empty()) {
-      s.muxer->chapters = static_cast<AVChapter**>(av_calloc(carried->chapters.size(), sizeof(AVChapter*)));
+    std::vector<const CarriedChapter*> chapters;
+    for (const CarriedChapter& in : carried->chapters) {
+      // At output time already; --duration ends them at the latest.
+      const double unit = av_q2d(in.time_base);
+      if (settings.carried_end_s && static_cast<double>(in.start) * unit >= *settings.carried_end_s - 1e-6) continue;
+      chapters.push_back(&in);
+    }
+    if (!chapters.empty()) {
+      s.muxer->chapters = static_cast<AVChapter**>(av_calloc(chapters.size(), sizeof(AVChapter*)));
       if (!s.muxer->chapters) throw std::bad_alloc();
-      for (const CarriedChapter& in : carried->chapters) {
+      for (const CarriedChapter* chapter : chapters) {
+        const CarriedChapter& in = *chapter;
+        std::int64_t end = in.end;
+        if (settings.carried_end_s)
+          end = std::min(end, static_cast<std::int64_t>(std::llround(*settings.carried_end_s / av_q2d(in.time_base))));
         auto* out = static_cast<AVChapter*>(av_mallocz(sizeof(AVChapter)));
         if (!out) throw std::bad_alloc();
-        *out = {in.id, in.time_base, in.start, in.end, nullptr};
+        *out = {in.id, in.time_base, in.start, end, nullptr};
         av_dict_copy(&out->metadata, in.metadata.get(), 0);
         s.muxer->chapters[s.muxer->nb_chapters++] = out;
       }
@@ -478,6 +596,11 @@ void VideoEncoder::write_source_packet(AVPacket* packet, int source_stream) {
                      re.frame->ch_layout, re.frame->sample_rate, start_s, s.writer);
       av_frame_unref(re.frame.get());
     }
+    return;
+  }
+  if (static_cast<std::size_t>(source_stream) < s.retimed_text.size() &&
+      s.retimed_text[static_cast<std::size_t>(source_stream)]) {
+    s.retimed_text[static_cast<std::size_t>(source_stream)]->write(*packet, s.writer);
     return;
   }
   packet->stream_index = out_index;

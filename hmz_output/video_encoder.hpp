@@ -25,6 +25,8 @@ struct EncoderSettings {
   bool overwrite = false;  // -y
   bool audio = true;       // carry the source's audio streams
   int bits = 8;            // bit depth to keep: 10-bit sources keep 10 bits where the codec allows
+  // --duration: the carried chapters end there at the latest (they come at output time).
+  std::optional<double> carried_end_s;
 };
 
 class VideoEncoder {
