@@ -1,15 +1,18 @@
 // `nelf probe IN`: what nelf sees in a media file — size, rate, codec, colour — and which stereo
 // layout it would use, with the detection rule that decided (DESIGN.md §6).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/commands.hpp"
 #include "core/printable.hpp"
+#include "inputs/media_streams.hpp"
 #include "inputs/source_drivers.hpp"
 #include "inputs/stereo_layout.hpp"
 #include "inputs/video_source.hpp"
@@ -36,6 +39,7 @@ struct ProbeResult {
   std::optional<StereoMetadata> metadata;
   LayoutDecision decision;
   DecodeStats stats;
+  MediaStreams streams;
 };
 
 ProbeResult probe(const ProbeOptions& options) {
@@ -61,7 +65,7 @@ ProbeResult probe(const ProbeOptions& options) {
   }
   if (!any_frame) throw VideoError(fmt::format("{}: no video frame could be decoded", options.input));
 
-  ProbeResult result{source.info(), source.stereo_metadata(), {}, source.stats()};
+  ProbeResult result{source.info(), source.stereo_metadata(), {}, source.stats(), {}};
   LayoutEvidence evidence;
   if (!options.layout.empty()) evidence.flag = parse_stereo_layout(options.layout);  // checked by CLI11
   evidence.swap_eyes = options.swap_eyes;
@@ -70,12 +74,54 @@ ProbeResult probe(const ProbeOptions& options) {
   evidence.height = result.info.height;
   evidence.display_aspect = result.info.display_aspect;
   evidence.filename = options.input;
+  evidence.multiview = result.info.multiview;
   result.decision = detect_stereo_layout(evidence);
+  result.streams = describe_media_streams(options.input, options.allow_network);
   return result;
 }
 
 nlohmann::json optional_number(const std::optional<double>& value) {
   return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+}
+
+nlohmann::json stereo_json(const std::optional<StereoMetadata>& metadata) {
+  return metadata
+             ? nlohmann::json{{"type", std::string(to_string(metadata->packing))}, {"inverted", metadata->inverted}}
+             : nlohmann::json(nullptr);
+}
+
+nlohmann::json multiview_json(Multiview multiview) {
+  return multiview == Multiview::none ? nlohmann::json(nullptr) : nlohmann::json(std::string(to_string(multiview)));
+}
+
+nlohmann::json stream_json(const MediaStream& s) {
+  nlohmann::json out = {{"index", s.index},
+                        {"type", s.type},
+                        {"codec", s.codec},
+                        {"profile", s.profile.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.profile)},
+                        {"language", s.language.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.language)},
+                        {"title", s.title.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.title)},
+                        {"default", s.is_default},
+                        {"forced", s.forced},
+                        {"hearing_impaired", s.hearing_impaired},
+                        {"visual_impaired", s.visual_impaired}};
+  if (s.type == "video") {
+    out["width"] = s.width;
+    out["height"] = s.height;
+    out["fps"] = s.fps;
+    out["pixel_format"] = s.pixel_format;
+    out["cover_art"] = s.cover_art;
+    out["stereo_metadata"] = stereo_json(s.stereo);
+    out["multiview"] = multiview_json(s.multiview);
+  } else if (s.type == "audio") {
+    out["channels"] = s.channels;
+    out["channel_layout"] = s.channel_layout;
+    out["sample_rate"] = s.sample_rate;
+  } else if (s.type == "attachment") {
+    out["filename"] = s.filename;
+    out["mimetype"] = s.mimetype;
+  }
+  return out;
 }
 
 void print_json(const ProbeResult& r) {
@@ -99,11 +145,48 @@ void print_json(const ProbeResult& r) {
       {"bits_per_component", info.bits_per_component},
       {"color_matrix", std::string(to_string(info.matrix))},
       {"color_range", std::string(to_string(info.range))},
-      {"stereo_metadata", r.metadata ? nlohmann::json{{"type", std::string(to_string(r.metadata->packing))},
-                                                      {"inverted", r.metadata->inverted}}
-                                     : nlohmann::json(nullptr)},
+      {"stereo_metadata", stereo_json(r.metadata)},
+      {"multiview", multiview_json(r.info.multiview)},
   };
+  nlohmann::json streams = nlohmann::json::array(), chapters = nlohmann::json::array();
+  for (const MediaStream& s : r.streams.streams) streams.push_back(stream_json(s));
+  for (const MediaChapter& c : r.streams.chapters)
+    chapters.push_back({{"id", c.id},
+                        {"start_s", c.start_s},
+                        {"end_s", c.end_s},
+                        {"title", c.title.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.title)}});
+  out["streams"] = std::move(streams);
+  out["chapters"] = std::move(chapters);
   fmt::print("{}\n", out.dump());
+}
+
+// One stream as a player's track list shows it: "#1 audio ac3 5.1(side), 48000 Hz [eng] "Surround
+// 5.1" (default)".
+std::string stream_line(const MediaStream& s) {
+  std::string line = fmt::format("#{} {} {}", s.index, s.type, s.codec);
+  if (!s.profile.empty()) line += fmt::format(" ({})", s.profile);
+  if (s.type == "video") {
+    line += fmt::format(" {}x{}", s.width, s.height);
+    if (s.fps > 0.0) line += fmt::format(", {:.3f} fps", s.fps);
+    if (!s.pixel_format.empty()) line += ", " + s.pixel_format;
+    if (s.stereo)
+      line += fmt::format(", stereo {}{}", to_string(s.stereo->packing), s.stereo->inverted ? " right first" : "");
+    if (s.multiview != Multiview::none) line += fmt::format(", {}", to_string(s.multiview));
+  } else if (s.type == "audio") {
+    line += fmt::format(" {}, {} Hz", s.channel_layout, s.sample_rate);
+  } else if (s.type == "attachment") {
+    line += fmt::format(" {}{}", s.filename, s.mimetype.empty() ? "" : " (" + s.mimetype + ")");
+  }
+  if (!s.language.empty()) line += fmt::format(" [{}]", s.language);
+  if (!s.title.empty()) line += fmt::format(" \"{}\"", s.title);
+  std::vector<std::string> flags;
+  if (s.is_default) flags.emplace_back("default");
+  if (s.forced) flags.emplace_back("forced");
+  if (s.hearing_impaired) flags.emplace_back("hearing impaired");
+  if (s.visual_impaired) flags.emplace_back("visual impaired");
+  if (s.cover_art) flags.emplace_back("cover art");
+  if (!flags.empty()) line += fmt::format(" ({})", fmt::join(flags, ", "));
+  return line;
 }
 
 void print_summary(const ProbeResult& r) {
@@ -123,8 +206,15 @@ void print_summary(const ProbeResult& r) {
   if (r.metadata)
     fmt::print("stereo:    {}{} (file metadata)\n", to_string(r.metadata->packing),
                r.metadata->inverted ? ", right view first" : "");
+  if (r.info.multiview != Multiview::none)
+    fmt::print("multiview: {} (FFmpeg decodes only the base view: 2D)\n", to_string(r.info.multiview));
   fmt::print("layout:    {}{} (rule: {})\n", to_string(r.decision.layout), r.decision.swap_eyes ? ", eyes swapped" : "",
              to_string(r.decision.rule));
+  fmt::print("streams:\n");
+  for (const MediaStream& s : r.streams.streams) fmt::print("  {}\n", printable(stream_line(s)));
+  if (!r.streams.chapters.empty()) fmt::print("chapters:\n");
+  for (const MediaChapter& c : r.streams.chapters)
+    fmt::print("  {:>9.3f} - {:>9.3f} s  {}\n", c.start_s, c.end_s, printable(c.title));
 }
 
 }  // namespace

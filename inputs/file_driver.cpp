@@ -65,6 +65,7 @@ class FileFrameSource final : public Source {
     evidence.filename = r.input;
     evidence.swap_eyes = r.swap_eyes;
     evidence.display_aspect = pending_->display_aspect;
+    evidence.multiview = source_.info().multiview;
     try {
       decision_ = detect_stereo_layout(evidence);
     } catch (const std::exception& e) {

@@ -112,6 +112,8 @@ std::string_view to_string(DetectionRule rule) {
   switch (rule) {
     case DetectionRule::flag:
       return "flag";
+    case DetectionRule::multiview:
+      return "multiview";
     case DetectionRule::metadata:
       return "metadata";
     case DetectionRule::frame_size:
@@ -173,6 +175,11 @@ LayoutDecision detect_stereo_layout(const LayoutEvidence& evidence) {
   const double aspect = evidence.display_aspect > 0.0 ? evidence.display_aspect : h > 0 ? ratio(w, h) : 0.0;
   LayoutDecision decision = [&]() -> LayoutDecision {
     if (evidence.flag) return {*evidence.flag, false, DetectionRule::flag, {}};
+    if (evidence.multiview != Multiview::none)
+      return {StereoLayout::mono, false, DetectionRule::multiview,
+              fmt::format("{}: {} stereo: FFmpeg decodes only its base view, so it plays in 2D (that view to both "
+                          "eyes)",
+                          evidence.filename.filename().string(), to_string(evidence.multiview))};
     if (evidence.metadata) {
       // Throws UnsupportedStereoMetadata for packings nelf cannot split.
       const MetadataLayout m = layout_from_stereo_metadata(*evidence.metadata, aspect);

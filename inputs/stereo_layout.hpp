@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/image.hpp"
+#include "inputs/multiview.hpp"
 #include "inputs/stereo_metadata.hpp"
 
 namespace nelf {
@@ -46,8 +47,8 @@ std::optional<FramePackedGeometry> frame_packed_geometry(int width, int height);
 StereoPair split_frame(const Image& frame, StereoLayout layout, bool swap_eyes = false);
 
 // Which rule of the detection order decided (`nelf probe` prints it).
-enum class DetectionRule { flag, metadata, frame_size, filename, aspect, fallback };
-// "flag", "metadata", "frame-size", "filename", "aspect", "default".
+enum class DetectionRule { flag, multiview, metadata, frame_size, filename, aspect, fallback };
+// "flag", "multiview", "metadata", "frame-size", "filename", "aspect", "default".
 std::string_view to_string(DetectionRule rule);
 
 // The first five fields are positional in callers: {flag, metadata, width, height, filename}.
@@ -56,9 +57,10 @@ struct LayoutEvidence {
   std::optional<StereoMetadata> metadata;  // stream side data, else a remembered frame-packing SEI
   int width = 0;                           // the full frame's size as delivered (after rotation)
   int height = 0;
-  std::filesystem::path filename;  // only the last component is looked at
-  bool swap_eyes = false;          // the user's --swap-eyes: swaps whatever was detected (XOR)
-  double display_aspect = 0.0;     // width x SAR / height for video; 0 means width / height
+  std::filesystem::path filename;         // only the last component is looked at
+  bool swap_eyes = false;                 // the user's --swap-eyes: swaps whatever was detected (XOR)
+  double display_aspect = 0.0;            // width x SAR / height for video; 0 means width / height
+  Multiview multiview = Multiview::none;  // a second view FFmpeg does not decode (inputs/multiview.hpp)
 };
 
 struct LayoutDecision {
@@ -68,7 +70,8 @@ struct LayoutDecision {
   std::string warning;  // non-empty when the result is a guess the user should know about
 };
 
-// Detection order: explicit flag -> metadata (layout_from_stereo_metadata: half or full from the
+// Detection order: explicit flag -> a multiview stream (H.264 MVC, MV-HEVC: only its base view
+// decodes, so mono with a warning that says why) -> metadata (layout_from_stereo_metadata: half or full from the
 // display aspect, see kFullSideBySideMinAspect) -> exact HDMI frame-packed frame size -> filename
 // tokens -> aspect (W/H >= 3 full SBS, W/H <= 1 full TAB) -> mono with a warning.
 // `.jps` files store right-left side-by-side by convention: they are sbs when nothing else says

@@ -109,6 +109,7 @@ struct VideoSource::Impl {
   // first and last timestamps of the decoded video frames (count_missing_frames).
   std::optional<double> packets_end_s;
   std::optional<double> first_frame_s, last_frame_s;
+  int multiview_packets_left = 64;  // packets still to look at for a second view's NAL units
 
   [[noreturn]] void fail(const std::string& what) const { throw VideoError(fmt::format("{}: {}", info.path, what)); }
 
@@ -167,8 +168,13 @@ struct VideoSource::Impl {
     if (const auto stopped = guard_stop(path, network)) throw VideoError(*stopped);
     if (found < 0) fail(fmt::format("not a readable media file: {}", error_string(found)));
 
-    for (unsigned i = 0; i < format->nb_streams; ++i)
-      if (format->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_AUDIO) ++info.audio_streams;
+    for (unsigned i = 0; i < format->nb_streams; ++i) {
+      const AVCodecParameters& stream_codec = *format->streams[i]->codecpar;
+      if (stream_codec.codec_type == AVMEDIA_TYPE_AUDIO) ++info.audio_streams;
+      // An MPEG-TS MVC sub-stream is a video stream of its own beside the base view's.
+      if (stream_codec.codec_type == AVMEDIA_TYPE_VIDEO && info.multiview == Multiview::none)
+        info.multiview = multiview_from_codec(stream_codec);
+    }
 
     const AVCodec* decoder = nullptr;
     int best = av_find_best_stream(format.get(), AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
@@ -554,6 +560,14 @@ struct VideoSource::Impl {
         const double end = static_cast<double>(ts + std::max<std::int64_t>(packet->duration, 0)) *
                            av_q2d(format->streams[packet->stream_index]->time_base);
         packets_end_s = std::max(packets_end_s.value_or(end), end);
+      }
+      // The second view's NAL units come with the base view's from the first access unit on.
+      if (info.multiview == Multiview::none && multiview_packets_left > 0) {
+        --multiview_packets_left;
+        const AVCodecParameters& packet_codec = *format->streams[packet->stream_index]->codecpar;
+        if (packet_codec.codec_type == AVMEDIA_TYPE_VIDEO)
+          info.multiview = multiview_from_packet(
+              packet_codec, {packet->data, packet->data ? static_cast<std::size_t>(packet->size) : 0u});
       }
       if (packet->stream_index == info.stream_index) {
         // The demuxer's parser reads each packet's header (H.264/HEVC/MPEG-2 sequence headers):

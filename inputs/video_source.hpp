@@ -17,6 +17,7 @@
 
 #include "core/image.hpp"
 #include "core/pixel_limit.hpp"
+#include "inputs/multiview.hpp"
 #include "inputs/stereo_metadata.hpp"
 
 namespace nelf {
@@ -61,6 +62,9 @@ struct VideoInfo {
   bool matrix_tagged = false;  // false: `matrix` is the default chosen from the height
   ColorRange range = ColorRange::limited;
   std::optional<StereoMetadata> stream_stereo;  // container/stream stereo metadata (Matroska, st3d)
+  // A second view coded against the decoded one (inputs/multiview.hpp), from the streams'
+  // parameters or the first packets read: FFmpeg decodes only the base view of it.
+  Multiview multiview = Multiview::none;
 };
 
 // A part of every frame to deliver averaged over blocks of pixels (VideoSource::reduce_regions).
