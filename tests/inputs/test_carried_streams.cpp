@@ -28,6 +28,7 @@ struct Packet {
   std::int64_t pts = 0, dts = 0;
   double t = 0;  // pts in seconds on the file's clock
   std::vector<std::uint8_t> data;
+  double length = 0;  // duration in seconds
   bool operator==(const Packet& o) const {
     return stream == o.stream && pts == o.pts && dts == o.dts && data == o.data;
   }
@@ -45,14 +46,19 @@ std::vector<Packet> read_directly(const std::filesystem::path& path, const std::
     if (std::find(wanted.begin(), wanted.end(), p->stream_index) != wanted.end()) {
       const AVRational tb = format->streams[p->stream_index]->time_base;
       const std::int64_t ts = p->pts != AV_NOPTS_VALUE ? p->pts : p->dts;
-      packets.push_back({p->stream_index, p->pts, p->dts, ts * av_q2d(tb), {p->data, p->data + p->size}});
+      packets.push_back({p->stream_index,
+                         p->pts,
+                         p->dts,
+                         ts * av_q2d(tb),
+                         {p->data, p->data + p->size},
+                         static_cast<double>(p->duration) * av_q2d(tb)});
     }
     av_packet_unref(p.get());
   }
   return packets;
 }
 
-Packet described(const AVPacket& p) { return {p.stream_index, p.pts, p.dts, 0, {p.data, p.data + p.size}}; }
+Packet described(const AVPacket& p) { return {p.stream_index, p.pts, p.dts, 0, {p.data, p.data + p.size}, 0}; }
 
 // Video, audio tagged French, SubRip subtitles (unless `codecs` has -sn), one chapter and a title:
 // 1 s at 10 fps.
@@ -165,6 +171,7 @@ TEST(FileCarriedStreams, InTransportStreamsOnlyACarriedPacketWaits) {
 }
 
 TEST(FileCarriedStreams, ShiftToTheOriginAndStopAtTheEnd) {
+  // (Subtitle events on screen at the origin, and cut at the end: tests/cli/test_convert_streams.)
   TempDir dir;
   const auto clip = make_clip(dir, "clip.mkv", "-c:a flac -c:s srt");
   const std::vector<int> wanted{1, 2};
@@ -174,6 +181,8 @@ TEST(FileCarriedStreams, ShiftToTheOriginAndStopAtTheEnd) {
   std::vector<Packet> expected;
   for (Packet p : read_directly(clip, wanted)) {
     if (p.t - 0.5 < -1e-6 || p.t - 0.5 >= 0.3) continue;
+    // Audio that would play past the end is left out (the output ends with its video).
+    if (p.stream == 1 && p.t - 0.5 + p.length > 0.3 + 1e-3) continue;
     p.pts -= 500;  // 0.5 s in Matroska's milliseconds
     p.dts -= 500;
     expected.push_back(p);
