@@ -52,6 +52,34 @@ void splice_mvc(const std::filesystem::path& from, const std::filesystem::path& 
       .write(reinterpret_cast<const char*>(out.data()), static_cast<std::streamsize>(out.size()));
 }
 
+// Gives every VCL NAL unit (types 0-21) of an Annex B HEVC stream a copy in layer 1 (nuh_layer_id
+// in the header's second byte), as MV-HEVC carries its second view; FFmpeg skips layers above 0.
+void add_hevc_layer(const std::filesystem::path& from, const std::filesystem::path& to) {
+  std::ifstream in(from, std::ios::binary);
+  const std::vector<std::uint8_t> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::size_t> starts;
+  for (std::size_t i = 0; i + 3 <= data.size(); ++i)
+    if (data[i] == 0 && data[i + 1] == 0 && data[i + 2] == 1) starts.push_back(i + 3);
+  ASSERT_FALSE(starts.empty());
+  std::vector<std::uint8_t> out;
+  for (std::size_t n = 0; n < starts.size(); ++n) {
+    std::size_t end = n + 1 < starts.size() ? starts[n + 1] - 3 : data.size();
+    while (end > starts[n] && data[end - 1] == 0) --end;
+    std::vector<std::uint8_t> nal(data.begin() + static_cast<std::ptrdiff_t>(starts[n]),
+                                  data.begin() + static_cast<std::ptrdiff_t>(end));
+    ASSERT_GE(nal.size(), 2u);
+    out.insert(out.end(), {0, 0, 0, 1});
+    out.insert(out.end(), nal.begin(), nal.end());
+    if (((nal[0] >> 1) & 0x3f) <= 21) {
+      nal[1] = static_cast<std::uint8_t>((1 << 3) | (nal[1] & 7));
+      out.insert(out.end(), {0, 0, 0, 1});
+      out.insert(out.end(), nal.begin(), nal.end());
+    }
+  }
+  std::ofstream(to, std::ios::binary)
+      .write(reinterpret_cast<const char*>(out.data()), static_cast<std::streamsize>(out.size()));
+}
+
 CommandResult probe(const std::filesystem::path& path, const std::string& extra = "") {
   return run_nelf("probe " + extra + " " + q(path));
 }
@@ -161,6 +189,23 @@ TEST_F(MvcStream, ConvertAndPlaySayWhyItIs2D) {
   const nlohmann::json j = nlohmann::json::parse(probe(dir_ / "mvc.h264", "--json --layout sbs-half").out);
   EXPECT_EQ(j["rule"], "flag");
   EXPECT_EQ(j["multiview"], "H.264 MVC");
+}
+
+TEST(ProbeStreams, MvHevcRawAndInMp4) {
+  TempDir dir;
+  make_media(dir / "base.hevc",
+             "-f lavfi -i testsrc2=s=320x180:r=10 -frames:v 5 -c:v libx265 -x265-params log-level=error -f hevc");
+  add_hevc_layer(dir / "base.hevc", dir / "mv.hevc");
+  make_media(dir / "mv.mp4", "-r 10 -i " + q(dir / "mv.hevc") + " -c copy");  // hvcC, length-prefixed
+  for (const char* name : {"mv.hevc", "mv.mp4"}) {
+    const CommandResult r = probe(dir / name, "--json");
+    ASSERT_EQ(r.status, 0) << name << ": " << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["multiview"], "MV-HEVC") << name;
+    EXPECT_EQ(j["rule"], "multiview") << name;
+    EXPECT_NE(r.err.find("MV-HEVC stereo: FFmpeg decodes only its base view"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(nlohmann::json::parse(probe(dir / "base.hevc", "--json").out)["multiview"], nullptr);
 }
 
 TEST(ProbeStreams, BadInputsFailInOneLine) {
