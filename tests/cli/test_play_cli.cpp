@@ -380,8 +380,8 @@ TEST(PlayOffscreen, PlaysWithoutADisplayServerAndPrintsTheSummary) {
   EXPECT_GT(std::chrono::steady_clock::now() - started, std::chrono::seconds(2));
 }
 
-// A stereo photo plays off screen as its one frame, read by the still driver (OpenImageIO), for the
-// frame period a still always had in play.
+// A stereo photo plays off screen as its one frame, read by the still driver (OpenImageIO), for
+// --image-duration.
 TEST(PlayOffscreen, PlaysAJpsAndAnMpoAsTheirOneFrame) {
   TempDir dir;
   write_stereo_photos(dir);
@@ -392,7 +392,7 @@ TEST(PlayOffscreen, PlaysAJpsAndAnMpoAsTheirOneFrame) {
   for (const auto& [name, described] : cases) {
     SCOPED_TRACE(name);
     const auto r = run_command("env -u DISPLAY LP_NUM_THREADS=2 " + std::string(NELF_BINARY) + " play " +
-                               q(dir / name) + " --output offscreen --no-audio");
+                               q(dir / name) + " --output offscreen --no-audio --image-duration 0.1 < /dev/null");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find(described), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("nelf: 1 frames shown, 0 repeated, 0 dropped\n"), std::string::npos) << r.err;
