@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -40,8 +41,10 @@ bool reads_stdin(const std::string& input) { return input == "-" || input == "pi
 
 // One entry of the playlist: what is remembered of it applied (unless the command line says
 // otherwise), played, and what the user left remembered.
-PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, Display& display, SourceRequest request,
-                      const WatchLater& watch_later, std::size_t index, std::size_t count) {
+// The display opens once the first entry has: a file that cannot be read is said before a window
+// appears (or instead of the error that there is no display).
+PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const std::function<Display&()>& display,
+                      SourceRequest request, const WatchLater& watch_later, std::size_t index, std::size_t count) {
   // Before it opens: an entry that fails is then named after its number.
   if (count > 1 && !args.quiet) fmt::print(stderr, "nelf: {}/{}: {}\n", index + 1, count, printable(request.input));
   const std::string path_name = std::filesystem::path(request.input).filename().string();
@@ -91,7 +94,7 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, Display
         fmt::format("{}: cannot start at {:g} s: the input cannot seek", printable(request.input), *options.start_s),
         2);
 
-  PlayResult result = play(display, *source, options, &interrupt_requested);
+  PlayResult result = play(display(), *source, options, &interrupt_requested);
   fmt::print(stderr, "nelf: {}\n", play_summary(result));
 
   if (key) {
@@ -150,10 +153,16 @@ PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::
   const WatchLater watch_later(args.remember ? WatchLater::default_state_home() : std::filesystem::path());
 
   const bool keys_from_stdin = std::none_of(entries.begin(), entries.end(), reads_stdin);
-  const auto display = open_live_display(
-      {args.output, args.monitor, args.connector, fmt::format("nelf: {}", entries.front()), args.gpu, keys_from_stdin},
-      common.profile, common.signal);
-  if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", printable(display->description()));
+  std::unique_ptr<Display> display;
+  const std::function<Display&()> open_display = [&]() -> Display& {
+    if (!display) {
+      display = open_live_display({args.output, args.monitor, args.connector, fmt::format("nelf: {}", entries.front()),
+                                   args.gpu, keys_from_stdin},
+                                  common.profile, common.signal);
+      if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", printable(display->description()));
+    }
+    return *display;
+  };
 
   PlayEnd end = PlayEnd::end_of_file;
   std::size_t played = 0;
@@ -161,7 +170,7 @@ PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::
   for (std::size_t index = 0; index < entries.size();) {
     request.input = entries[index];
     try {
-      end = play_entry(args, common, *display, request, watch_later, index, entries.size()).end;
+      end = play_entry(args, common, open_display, request, watch_later, index, entries.size()).end;
       ++played;
     } catch (const UserError& e) {
       // One file is the whole command: its error is play's. In a playlist it is skipped.
