@@ -1,8 +1,12 @@
-// `nelf play IN`: watch a stereo video on the HMD (or a preview window) with sound: the player
-// engine (player/player) on the display --output picks.
+// `nelf play IN...`: watch stereo videos and photos on the HMD (or a preview window) with sound:
+// the player engine (player/player) on the display --output picks, one input after the other.
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -18,10 +22,107 @@
 #include "player/interrupt.hpp"
 #include "player/live_display.hpp"
 #include "player/player.hpp"
+#include "player/playlist.hpp"
+#include "player/watch_later.hpp"
 
 namespace nelf::app {
 
+namespace {
+
+void warn(const std::string& line) { fmt::print(stderr, "nelf: warning: {}\n", printable(line)); }
+
+std::string clock_time(double seconds) {
+  const long s = std::lround(std::floor(std::max(0.0, seconds)));
+  return fmt::format("{}:{:02d}:{:02d}", s / 3600, static_cast<int>(s / 60 % 60), static_cast<int>(s % 60));
+}
+
+// An input read from stdin: the offscreen output then takes no keys from it.
+bool reads_stdin(const std::string& input) { return input == "-" || input == "pipe:" || input == "pipe:0"; }
+
+// One entry of the playlist: what is remembered of it applied (unless the command line says
+// otherwise), played, and what the user left remembered.
+// The display opens once the first entry has: a file that cannot be read is said before a window
+// appears (or instead of the error that there is no display).
+PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const std::function<Display&()>& display,
+                      SourceRequest request, const WatchLater& watch_later, std::size_t index, std::size_t count) {
+  // Before it opens: an entry that fails is then named after its number.
+  if (count > 1 && !args.quiet) fmt::print(stderr, "nelf: {}/{}: {}\n", index + 1, count, printable(request.input));
+  const std::string path_name = std::filesystem::path(request.input).filename().string();
+  const std::optional<std::string> key = args.remember ? WatchLater::key_for(request.input) : std::nullopt;
+  const WatchLaterRecord record = key ? watch_later.load(*key, warn) : WatchLaterRecord{};
+  request.right = args.right;
+  request.layout = args.right.empty() ? common.layout : StereoLayout::pair;
+  if (!common.layout && args.right.empty() && record.layout) {
+    request.layout = parse_stereo_layout(*record.layout);
+    if (request.layout && !args.quiet)
+      fmt::print(stderr, "nelf: layout {} as last time (--layout overrides)\n", *record.layout);
+  }
+  request.swap_eyes = args.swap_eyes || record.swap_eyes.value_or(false);
+  const auto source = open_source_for_depth(request, common.compositor.depth, common.profile);
+  const SourceInfo info = source->info();
+
+  PlayerOptions options;
+  options.profile = common.profile;
+  options.signal = common.signal;
+  options.compositor = common.compositor;
+  options.audio = !args.no_audio;
+  options.log_frames = args.log_frames;
+  options.quiet = args.quiet;
+  options.image_duration_s = args.image_duration;
+  options.has_previous = index > 0;
+  options.has_next = index + 1 < count;
+  if (count > 1) options.announce = fmt::format("{}/{}: {}", index + 1, count, path_name);
+  // Photos have no time to start at: --start and resuming are for the videos of the playlist.
+  if (!info.still) {
+    if (args.start) {
+      if (info.duration_s && *args.start >= *info.duration_s)
+        throw UserError(fmt::format("{}: --start {:g} is past the end of the video ({:.3g} s)",
+                                    printable(request.input), *args.start, *info.duration_s),
+                        1);
+      options.start_s = args.start;
+    } else if (args.resume && record.position_s && *record.position_s > 0 &&
+               (!info.duration_s || *record.position_s < *info.duration_s)) {
+      options.start_s = record.position_s;
+      options.announce = fmt::format("resuming at {}", clock_time(*record.position_s));
+      if (!args.quiet)
+        fmt::print(stderr, "nelf: resuming at {} (--no-resume starts from the beginning)\n",
+                   clock_time(*record.position_s));
+    }
+  }
+  if (options.start_s && !info.seekable)
+    throw UserError(
+        fmt::format("{}: cannot start at {:g} s: the input cannot seek", printable(request.input), *options.start_s),
+        2);
+
+  PlayResult result = play(display(), *source, options, &interrupt_requested);
+  fmt::print(stderr, "nelf: {}\n", play_summary(result));
+
+  if (key) {
+    WatchLaterRecord left = record;
+    // Stopped before the end: resume there next time; played to the end or left for another file:
+    // the next time starts at the beginning, as mpv's.
+    const bool stopped =
+        result.end == PlayEnd::quit_key || result.end == PlayEnd::window_closed || result.end == PlayEnd::interrupted;
+    left.position_s.reset();
+    if (args.resume && stopped && !info.still && result.position_s && *result.position_s > 0)
+      left.position_s = result.position_s;
+    const bool swapped = request.swap_eyes != result.eyes_swapped;
+    if (swapped || record.swap_eyes) left.swap_eyes = swapped;
+    // A pair's second file is given each time (--right): only a one-file layout is remembered.
+    if (common.layout && *common.layout != StereoLayout::pair) left.layout = args.layout;
+    watch_later.save(*key, left, warn);
+  }
+  return result;
+}
+
+}  // namespace
+
 PlayEnd play_input(const PlayArgs& args, SourceRequest request) {
+  const std::string input = request.input;
+  return play_inputs(args, request, {input});
+}
+
+PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::vector<std::string>& inputs) {
   quiet_ffmpeg_logs(true);
   // Off screen, play renders headless like convert, on the GPU --gpu picks.
   if (args.output != "offscreen") refuse_gpu_for_live_output(args.gpu, "play");
@@ -35,35 +136,59 @@ PlayEnd play_input(const PlayArgs& args, SourceRequest request) {
     throw UserError("--monitor chooses the monitor for --output fullscreen", 2);
   if (!args.connector.empty() && args.output != "kms")
     throw UserError("--connector chooses the HDMI connector for --output kms", 2);
+  if (args.start && !(*args.start >= 0)) throw UserError("--start must be 0 or more seconds", 2);
+  if (args.image_duration && !(*args.image_duration > 0))
+    throw UserError("--image-duration must be more than 0 seconds", 2);
+  const std::vector<std::string> entries = expand_playlist(inputs, warn);
+  if (entries.size() > 1 && !args.right.empty())
+    throw UserError("--right gives the right view of one input; play the pairs one at a time", 2);
 
   // Before the input opens: Ctrl-C also ends a wait for a window that is not there yet.
   InterruptGuard guard;
+  SourceRequest request = base;
   request.stop = &interrupt_requested;
-  request.right = args.right;
-  request.layout = args.right.empty() ? common.layout : StereoLayout::pair;
-  request.swap_eyes = args.swap_eyes;
   request.quiet = args.quiet;
   request.allow_network = args.allow_network;
   request.max_pixels = args.max_pixels;
-  const auto source = open_source_for_depth(request, common.compositor.depth, common.profile);
+  const WatchLater watch_later(args.remember ? WatchLater::default_state_home() : std::filesystem::path());
 
-  PlayerOptions options;
-  options.profile = common.profile;
-  options.signal = common.signal;
-  options.compositor = common.compositor;
-  options.audio = !args.no_audio;
-  options.log_frames = args.log_frames;
-  options.quiet = args.quiet;
+  const bool keys_from_stdin = std::none_of(entries.begin(), entries.end(), reads_stdin);
+  std::unique_ptr<Display> display;
+  const std::function<Display&()> open_display = [&]() -> Display& {
+    if (!display) {
+      display = open_live_display({args.output, args.monitor, args.connector, fmt::format("nelf: {}", entries.front()),
+                                   args.gpu, keys_from_stdin},
+                                  common.profile, common.signal);
+      if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", printable(display->description()));
+    }
+    return *display;
+  };
 
-  const auto display =
-      open_live_display({args.output, args.monitor, args.connector, fmt::format("nelf: {}", request.input), args.gpu},
-                        common.profile, common.signal);
-  if (!args.quiet) fmt::print(stderr, "nelf: playing on {}\n", printable(display->description()));
-
-  const PlayResult result = play(*display, *source, options, &interrupt_requested);
-  fmt::print(stderr, "nelf: {}\n", play_summary(result));
-  if (result.end == PlayEnd::interrupted) throw UserError("interrupted", 130);
-  return result.end;
+  PlayEnd end = PlayEnd::end_of_file;
+  std::size_t played = 0;
+  bool forward = true;
+  for (std::size_t index = 0; index < entries.size();) {
+    request.input = entries[index];
+    try {
+      end = play_entry(args, common, open_display, request, watch_later, index, entries.size()).end;
+      ++played;
+    } catch (const UserError& e) {
+      // One file is the whole command: its error is play's. In a playlist it is skipped.
+      if (entries.size() == 1 || interrupt_requested) throw;
+      fmt::print(stderr, "nelf: skipped: {}\n", printable(e.what()));
+      end = forward ? PlayEnd::next_file : PlayEnd::previous_file;
+      if (!forward && index == 0) end = PlayEnd::next_file;
+    }
+    if (end == PlayEnd::interrupted) throw UserError("interrupted", 130);
+    if (end == PlayEnd::quit_key || end == PlayEnd::window_closed) break;
+    forward = end != PlayEnd::previous_file;
+    if (forward)
+      ++index;
+    else
+      --index;
+  }
+  if (played == 0) throw UserError(fmt::format("none of the {} inputs could be played", entries.size()), 1);
+  return end;
 }
 
 void add_play_options(CLI::App& cmd, PlayArgs& args) {
@@ -80,13 +205,23 @@ void add_play_options(CLI::App& cmd, PlayArgs& args) {
 
 void add_play_command(CLI::App& app) {
   auto args = std::make_shared<PlayArgs>();
-  auto* cmd = app.add_subcommand("play", "Watch a stereo video on the display (HMD over HDMI, or a preview window)");
-  add_input_option(*cmd, *args);
+  auto* cmd = app.add_subcommand("play",
+                                 "Watch stereo videos and photos on the display (HMD over HDMI, or a preview "
+                                 "window)");
+  cmd->add_option("input", args->inputs,
+                  "Stereo images or videos (side-by-side, top-bottom, frame-packed, JPS, MPO, ...), folders of them, "
+                  ".m3u playlists, or a live window (x11:window=TITLE); several play one after the other")
+      ->required();
   add_play_options(*cmd, *args);
+  cmd->add_option("--start", args->start, "Start each video at this time (seconds; not photos)");
+  cmd->add_option("--image-duration", args->image_duration,
+                  "Show each photo this many seconds, then the next (default: until q or the next-file key)");
+  cmd->add_flag("--no-resume", args->no_resume, "Start from the beginning, not where the file was stopped last time");
   cmd->callback([args] {
+    args->resume = !args->no_resume;
+    args->remember = true;
     SourceRequest request;
-    request.input = args->input;
-    play_input(*args, request);
+    play_inputs(*args, request, args->inputs);
   });
 }
 

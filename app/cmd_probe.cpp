@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -15,6 +17,7 @@
 #include "inputs/media_streams.hpp"
 #include "inputs/source_drivers.hpp"
 #include "inputs/stereo_layout.hpp"
+#include "inputs/still_source.hpp"
 #include "inputs/video_source.hpp"
 
 namespace nelf::app {
@@ -76,6 +79,21 @@ ProbeResult probe(const ProbeOptions& options) {
   evidence.filename = options.input;
   evidence.multiview = result.info.multiview;
   result.decision = detect_stereo_layout(evidence);
+  // FFmpeg sees an MPO's first JPEG only: its layout is the one play and convert read, the two
+  // images of the file (the still reader's, which says why it chose it).
+  std::string extension = std::filesystem::path(options.input).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".mpo") {
+    StillOptions still;
+    still.layout = evidence.flag;
+    still.swap_eyes = options.swap_eyes;
+    still.max_pixels = options.max_pixels;
+    try {
+      result.decision = load_still(options.input, still).decision;
+    } catch (const StillError& e) {
+      throw UserError(e.what());
+    }
+  }
   result.streams = describe_media_streams(options.input, options.allow_network);
   return result;
 }

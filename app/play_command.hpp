@@ -2,7 +2,9 @@
 // What `nelf play` and `nelf run` share: the options of watching on a display and the run of the
 // player on one input (`run` plays its game's window with them).
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "app/commands.hpp"
 #include "inputs/source.hpp"
@@ -17,6 +19,13 @@ struct PlayArgs : CommonArgs {
   bool no_audio = false;
   bool quiet = false;
   std::string log_frames;
+  // play's own (nelf run plays a live window: no playlist, no start, nothing remembered).
+  std::vector<std::string> inputs;       // INPUT...: files, folders, .m3u playlists
+  std::optional<double> start;           // --start
+  std::optional<double> image_duration;  // --image-duration
+  bool no_resume = false;                // --no-resume
+  bool resume = false;                   // play: on unless --no-resume
+  bool remember = false;                 // play: keep each file's position and set-up between runs
 };
 
 // The CommonArgs options (without INPUT) and play's own, on `cmd`.
@@ -26,5 +35,9 @@ void add_play_options(CLI::App& cmd, PlayArgs& args);
 // `args` names until it ends, the user quits or Ctrl-C; prints the summary line. Throws UserError
 // (status 130 when interrupted) as play reports it.
 PlayEnd play_input(const PlayArgs& args, SourceRequest request);
+
+// The same for each input of `inputs` in turn on one display, as a playlist: the keys step to the
+// next and previous one; an entry that fails is skipped with one line when there are others.
+PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& request, const std::vector<std::string>& inputs);
 
 }  // namespace nelf::app

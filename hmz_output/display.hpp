@@ -29,6 +29,9 @@ struct DisplayOptions {
                                 // offering a 3D frame-packing mode)
   std::string title = "nelf";   // window title
   std::optional<int> gpu;       // offscreen: the EGL device (--gpu; unset: NELF_GPU, else the first hardware one)
+  // offscreen: the keys typed into a pipe or a file on stdin, one per refresh (a scripted session;
+  // off when the input itself is read from stdin).
+  bool keys_from_stdin = false;
 };
 
 class Display : public Sink {

@@ -3,15 +3,22 @@
 // else the first hardware device, else Mesa's llvmpipe) and shown to no one; the player paces it by the
 // clock at the signal's refresh rate, as it paces a window without vsync. It is what the player's
 // tests run on, and a way to time the whole play loop on a machine without a monitor — as mpv's
-// `--vo=null` and Monado's null compositor are.
+// `--vo=null` and Monado's null compositor are. Keys come from stdin when it is a pipe or a file,
+// one per refresh, so that a session scripted as the bytes a terminal sends is deterministic.
 #include <fmt/format.h>
+#include <poll.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <deque>
 #include <memory>
 #include <stdexcept>
 
 #include "core/gl/egl_context.hpp"
 #include "core/gl/objects.hpp"
 #include "hmz_output/display.hpp"
+#include "hmz_output/terminal_keys.hpp"
 
 namespace nelf {
 namespace {
@@ -34,6 +41,10 @@ class OffscreenDisplay final : public Display {
     glClearNamedFramebufferfv(packed_fbo_.id(), GL_COLOR, 0, black);
     refresh_hz_ = options.signal.timing ? options.signal.timing->refresh_hz() : 60.0;
     gl::check_error("opening the offscreen display");
+    struct stat st {};
+    // Not a terminal: raw mode would take it from the user's shell; a window or kms is for typing.
+    reading_keys_ =
+        options.keys_from_stdin && ::fstat(STDIN_FILENO, &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISREG(st.st_mode));
   }
 
   ~OffscreenDisplay() override {
@@ -61,7 +72,13 @@ class OffscreenDisplay final : public Display {
   }
   double refresh_hz() const override { return refresh_hz_; }
   bool vsync() const override { return false; }
-  std::vector<KeyPress> poll_events() override { return {}; }
+  std::vector<KeyPress> poll_events() override {
+    if (keys_.empty()) read_keys();
+    if (keys_.empty()) return {};
+    std::vector<KeyPress> one{keys_.front()};
+    keys_.pop_front();
+    return one;
+  }
   bool close_requested() const override { return false; }
 
   std::string description() const override {
@@ -75,6 +92,24 @@ class OffscreenDisplay final : public Display {
   gl::Texture packed_texture_;
   gl::Framebuffer packed_fbo_;
   double refresh_hz_ = 60.0;
+  bool reading_keys_ = false;
+  TerminalKeyParser parser_;
+  std::deque<KeyPress> keys_;
+
+  // What stdin holds now, never waiting; at its end, no more keys.
+  void read_keys() {
+    if (!reading_keys_) return;
+    pollfd fd{STDIN_FILENO, POLLIN, 0};
+    if (::poll(&fd, 1, 0) <= 0 || !(fd.revents & (POLLIN | POLLHUP))) return;
+    char bytes[64];
+    const ssize_t n = ::read(STDIN_FILENO, bytes, sizeof bytes);
+    if (n < 0 && (errno == EINTR || errno == EAGAIN)) return;
+    if (n <= 0) {
+      reading_keys_ = false;
+      return;
+    }
+    for (const KeyPress& key : parser_.feed(std::string_view(bytes, static_cast<std::size_t>(n)))) keys_.push_back(key);
+  }
 };
 
 }  // namespace

@@ -49,6 +49,7 @@ struct SourceInfo {
   std::optional<long> expected_frames;  // stereo frames from pts_s 0, when known
   bool seekable = false;                // seek() can succeed
   bool live = false;                    // next() waits for frames made in real time (a capture)
+  bool still = false;                   // one picture (a photo): play keeps it on screen until told otherwise
   std::string description;              // one line naming the input, its size and layout
   ViewGeometry view;                    // of every frame; what negotiate() formats are sized from
 };

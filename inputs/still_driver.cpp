@@ -65,6 +65,7 @@ class StillFrameSource final : public Source {
     info.duration_s = 1.0 / kStillFrameRate;
     info.expected_frames = 1;
     info.seekable = true;
+    info.still = true;
     info.description = description_;
     info.view = {views_->left.image.width(), views_->left.image.height(), views_->left.aspect()};
     return info;

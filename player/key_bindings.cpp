@@ -50,6 +50,13 @@ const std::vector<KeyBinding>& key_bindings() {
        "(`nelf calibrate`'s grid, 16 cells, yellow centre cross, L/R, over both views: alignment of the eyes "
        "and the lens grid)",
        ""},
+      {S::play,
+       {{ch(U'>'), C::next_file}, {named(N::enter), C::next_file}, {ch(U'<'), C::previous_file}},
+       "> Enter <",
+       "`>`, Enter / `<`",
+       "next / previous file of the playlist",
+       "(on a photo also → / ←)",
+       ""},
       {S::play, {{ch(U'f'), C::fullscreen}, {ch(U'F'), C::fullscreen}}, "f", "f", "fullscreen on / off", "", ""},
       {S::play,
        {{ch(U'h'), C::help}, {ch(U'H'), C::help}, {ch(U'?'), C::help}},

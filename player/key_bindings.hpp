@@ -31,6 +31,8 @@ enum class Command {
   swap_eyes,
   calibration_grid,
   fullscreen,
+  next_file,
+  previous_file,
   // calibrate
   next_eye,
   shift_left,

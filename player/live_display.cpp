@@ -17,6 +17,7 @@ std::unique_ptr<Display> open_live_display(const LiveDisplayRequest& request, co
   options.connector = request.connector;
   options.title = request.title;
   options.gpu = request.gpu;
+  options.keys_from_stdin = request.keys_from_stdin;
   const DisplayDriver* driver = nullptr;
   try {
     driver = &display_driver(request.output);

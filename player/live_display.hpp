@@ -17,7 +17,8 @@ struct LiveDisplayRequest {
   std::string monitor;            // fullscreen: a name to match ("" = the one containing "HMZ")
   std::string connector;          // kms: connector name ("" = the first with a 3D frame-packing mode)
   std::string title = "nelf";
-  std::optional<int> gpu;  // offscreen only
+  std::optional<int> gpu;        // offscreen only
+  bool keys_from_stdin = false;  // offscreen only: DisplayOptions::keys_from_stdin
 };
 
 std::unique_ptr<Display> open_live_display(const LiveDisplayRequest& request, const Profile& profile,

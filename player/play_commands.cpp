@@ -31,19 +31,32 @@ void PlayCommands::expire_message() {
   state_.dirty = true;
 }
 
-void PlayCommands::seek_by(double delta) {
-  PlaybackClock& clock = sound_.clock();
-  const double from = state_.current ? state_.current->pts_s : clock.now();
-  double target = std::max(0.0, from + delta);
+void PlayCommands::seek_to(double seconds, const std::string& what) {
+  double target = std::max(0.0, seconds);
   if (duration_s_) target = std::min(target, std::max(0.0, *duration_s_ - 0.001));
+  PlaybackClock& clock = sound_.clock();
   queue_.seek(target);
   sound_.seek(target);
   clock.restart_at(target);
   clock.set_paused(true);  // until the first frame after the seek is decoded
   state_.awaiting_seek = true;
+  state_.seek_target_s = target;
   scheduler_.reset();
-  say(fmt::format("{} {:.0f} s: {}:{:02d}", delta < 0 ? "back" : "forward", std::abs(delta),
-                  static_cast<int>(target) / 60, static_cast<int>(target) % 60));
+  if (!what.empty()) say(what);
+}
+
+void PlayCommands::seek_by(double delta) {
+  const double from = state_.current ? state_.current->pts_s : sound_.clock().now();
+  double target = std::max(0.0, from + delta);
+  if (duration_s_) target = std::min(target, std::max(0.0, *duration_s_ - 0.001));
+  seek_to(target, fmt::format("{} {:.0f} s: {}:{:02d}", delta < 0 ? "back" : "forward", std::abs(delta),
+                              static_cast<int>(target) / 60, static_cast<int>(target) % 60));
+}
+
+std::optional<PlayEnd> PlayCommands::other_file(bool next) {
+  if (next ? options_.has_next : options_.has_previous) return next ? PlayEnd::next_file : PlayEnd::previous_file;
+  say(next ? "this is the last file" : "this is the first file");
+  return std::nullopt;
 }
 
 void PlayCommands::change_profile(const Profile& changed, const std::string& what) {
@@ -57,19 +70,25 @@ void PlayCommands::change_profile(const Profile& changed, const std::string& wha
   }
 }
 
-bool PlayCommands::apply(Command command) {
+std::optional<PlayEnd> PlayCommands::apply(Command command) {
   switch (command) {
     case Command::quit:
-      return false;
+      return PlayEnd::quit_key;
+    case Command::next_file:
+      return other_file(true);
+    case Command::previous_file:
+      return other_file(false);
     case Command::pause:
       state_.paused = !state_.paused;
       if (!state_.awaiting_seek && state_.started) sound_.clock().set_paused(state_.paused);
       say(state_.paused ? "paused" : "playing");
       break;
     case Command::seek_back_10s:
+      if (still_) return other_file(false);  // a photo has no time to seek in: the arrows step as in a viewer
       seek_by(-10);
       break;
     case Command::seek_forward_10s:
+      if (still_) return other_file(true);
       seek_by(10);
       break;
     case Command::seek_forward_60s:
@@ -127,7 +146,7 @@ bool PlayCommands::apply(Command command) {
     default:
       break;  // a calibrate command: not bound in play
   }
-  return true;
+  return std::nullopt;
 }
 
 }  // namespace nelf::playback

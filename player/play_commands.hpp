@@ -31,6 +31,7 @@ struct PlayState {
   bool swap_eyes = false;
   bool dirty = false;              // the packed frame must be rendered again
   bool awaiting_seek = false;      // the clock waits, paused, for the first frame after a seek
+  double seek_target_s = 0.0;      // where the last seek went (the position while awaiting_seek)
   bool show_while_paused = false;  // a seek while paused shows the first frame at the new place
   std::shared_ptr<const StereoVideoFrame> current;
 };
@@ -39,7 +40,7 @@ class PlayCommands {
  public:
   PlayCommands(PlayState& state, Display& display, FrameCompositor& compositor, FrameQueue& queue, PlaySound& sound,
                FrameScheduler& scheduler, const PlayerOptions& options, std::optional<double> duration_s,
-               ViewGeometry view)
+               ViewGeometry view, bool still)
       : state_(state),
         display_(display),
         compositor_(compositor),
@@ -48,10 +49,14 @@ class PlayCommands {
         scheduler_(scheduler),
         options_(options),
         duration_s_(duration_s),
-        view_(view) {}
+        view_(view),
+        still_(still) {}
 
-  // Carries out `command`; false for quit.
-  bool apply(Command command);
+  // Carries out `command`; why play ends now, if it does (quit, another file of the playlist).
+  std::optional<PlayEnd> apply(Command command);
+  // Goes to `seconds` in the movie's time (clamped to it) as a seek key does, saying `what` on screen
+  // ("" for nothing).
+  void seek_to(double seconds, const std::string& what);
   // A message on screen for two seconds (when on-screen messages are on); the frame is redrawn.
   void say(std::string text);
   // Takes the message off the screen once its two seconds are up.
@@ -61,6 +66,7 @@ class PlayCommands {
 
  private:
   void seek_by(double delta_s);
+  std::optional<PlayEnd> other_file(bool next);
   void change_profile(const Profile& changed, const std::string& what);
 
   PlayState& state_;
@@ -72,6 +78,7 @@ class PlayCommands {
   const PlayerOptions& options_;
   std::optional<double> duration_s_;
   ViewGeometry view_;          // the source's, for the view format a change of the optics asks for
+  bool still_;                 // a photo: ← and → step through the playlist instead of seeking
   std::size_t help_line_ = 0;  // the next line of the key help that h shows
   std::string message_;
   std::chrono::steady_clock::time_point message_until_{};

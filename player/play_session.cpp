@@ -73,7 +73,7 @@ PlaySession::PlaySession(Display& display_, Source& source_, const PlayerOptions
       view_format(source.negotiate(compositor.wanted_view_format(info.view))),
       queue(queue_capacity),
       decoder([this] { decode_loop(source, queue); }),
-      commands(state, display, compositor, queue, sound, scheduler, options, info.duration_s, info.view),
+      commands(state, display, compositor, queue, sound, scheduler, options, info.duration_s, info.view, info.still),
       render_time(refresh_period),
       ticker(refresh_period) {}
 
@@ -82,16 +82,20 @@ void PlaySession::wait_for_first_frame() {
     bool end = false;
     queue.snapshot(end);
     if (end || (stop && stop->load()) || display.close_requested()) break;
-    display.poll_events();
+    // Kept for the first refresh: a key typed while the file opens is not lost.
+    for (const KeyPress& key : display.poll_events()) early_keys.push_back(key);
   }
 }
 
 std::optional<PlayEnd> PlaySession::take_keys_and_events() {
-  bool quit = false;
-  for (const KeyPress& key : display.poll_events())
+  std::vector<KeyPress> keys = std::move(early_keys);
+  early_keys.clear();
+  for (const KeyPress& key : display.poll_events()) keys.push_back(key);
+  std::optional<PlayEnd> why;
+  for (const KeyPress& key : keys)
     if (const std::optional<Command> command = command_for(KeyScope::play, key))
-      if (!commands.apply(*command)) quit = true;
-  if (quit) return PlayEnd::quit_key;
+      if (const std::optional<PlayEnd> end = commands.apply(*command); end && !why) why = end;
+  if (why) return why;
   if (display.close_requested()) return PlayEnd::window_closed;
   if (stop && stop->load()) return PlayEnd::interrupted;
   return std::nullopt;
@@ -132,6 +136,11 @@ PlayResult PlaySession::finish(std::int64_t composited_ahead) {
   result.counters = scheduler.counters();
   result.video_decode_errors = source.lost_frames();
   result.composited_ahead = composited_ahead;
+  if (state.awaiting_seek)
+    result.position_s = state.seek_target_s;
+  else if (state.current)
+    result.position_s = state.current->pts_s;
+  result.eyes_swapped = state.swap_eyes;
   return result;
 }
 

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <optional>
 #include <thread>
+#include <vector>
 
 #include "compositor/frame_compositor.hpp"
 #include "hmz_output/display.hpp"
@@ -79,6 +80,7 @@ struct PlaySession {
   PlayCommands commands;
   RenderTime render_time;  // the first render, which compiles shaders, does not count
   RefreshTicker ticker;
+  std::vector<KeyPress> early_keys;  // typed while waiting for the first frame
 };
 
 }  // namespace nelf::playback

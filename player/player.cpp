@@ -18,10 +18,23 @@ std::string play_summary(const PlayResult& r) {
   return line;
 }
 
+namespace {
+
+// A photo has had its one frame's time when it is first on screen: it stays until a key, the window
+// or Ctrl-C ends play, or for --image-duration on the master clock (paused, it waits).
+bool holds_still(playback::PlaySession& session) {
+  if (!session.info.still) return false;
+  return !session.options.image_duration_s || session.clock.now() < *session.options.image_duration_s;
+}
+
+}  // namespace
+
 // The pipeline, once per refresh: keys, the frame the clock asks for, render and present, the log,
 // the next frames composited ahead, the wait for the next refresh.
 PlayResult play(Display& display, Source& source, const PlayerOptions& options, const std::atomic<bool>* stop) {
   playback::PlaySession session(display, source, options, stop);
+  if (options.start_s) session.commands.seek_to(*options.start_s, "");
+  if (!options.announce.empty()) session.commands.say(options.announce);
   session.wait_for_first_frame();
   PlayEnd end = PlayEnd::end_of_file;
   std::int64_t composited_ahead = 0;
@@ -32,7 +45,7 @@ PlayResult play(Display& display, Source& source, const PlayerOptions& options, 
     }
     playback::Refresh step = playback::choose_frame(session);
     session.commands.expire_message();
-    if (step.finished) break;
+    if (step.finished && !holds_still(session)) break;
     playback::present_frame(session, step);
     if (step.ahead) ++composited_ahead;
     playback::log_refresh(session, refresh, step);

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "compositor/compositor.hpp"
@@ -42,9 +43,21 @@ struct PlayerOptions {
   // refresh waits for the decoder to fill the queue (or end), so that the frames shown, repeated
   // and dropped are what FrameScheduler makes of the clip's timestamps and the refresh rate.
   std::shared_ptr<playback::SteppedClock> clock;
+  // A photo (SourceInfo::still) stays on screen until q, the window closing or Ctrl-C; with this,
+  // for this long on the master clock (a slideshow: the pause key holds it).
+  std::optional<double> image_duration_s;
+  // Where play starts, in the movie's time (--start, or where the user stopped last time).
+  std::optional<double> start_s;
+  // The files of the playlist before and after this one: what the keys for the next and the
+  // previous file can go to.
+  bool has_next = false;
+  bool has_previous = false;
+  // Said on screen with the first frame ("resuming at 0:12:34", "2/5: photo.jps"); "" for none.
+  std::string announce;
 };
 
-enum class PlayEnd { end_of_file, quit_key, window_closed, interrupted };
+// next_file / previous_file: the user asked for another file of the playlist.
+enum class PlayEnd { end_of_file, quit_key, window_closed, interrupted, next_file, previous_file };
 
 struct PlayResult {
   PlayEnd end = PlayEnd::end_of_file;
@@ -54,6 +67,10 @@ struct PlayResult {
   std::int64_t composited_ahead = 0;  // frames shown as composited ahead on a worker (CPU path)
   bool had_sound = false;
   std::string sound;  // "pulseaudio, 48000 Hz …" or why there was none
+  // Where play stopped, in the movie's time (the target of a seek not yet shown); none when nothing
+  // was shown.
+  std::optional<double> position_s;
+  bool eyes_swapped = false;  // the user swapped the eyes (key s) an odd number of times
 };
 
 // Plays `source` on `display` until the end of the file, q/Esc, the window closing or `*stop`

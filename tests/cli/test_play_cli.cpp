@@ -295,22 +295,6 @@ TEST(PlayCliErrors, BadInputsAsConvertSaysThem) {
       << output.err;
 }
 
-// A JPS (right view first) and an MPO (two JPEGs), written for the test.
-void write_stereo_photos(const TempDir& dir) {
-  const Image red = filled_image(32, 18, {0.75f, 0.2f, 0.1f, 1.f}),
-              blue = filled_image(32, 18, {0.1f, 0.25f, 0.75f, 1.f});
-  Image jps(64, 18);
-  for (int y = 0; y < 18; ++y)
-    for (int x = 0; x < 32; ++x) {
-      jps.at(x, y) = blue.at(x, y);
-      jps.at(32 + x, y) = red.at(x, y);
-    }
-  write_test_image(dir / "photo.jps", jps, 3, OIIO::TypeDesc::UINT8, "jpeg");
-  write_test_image(dir / "l.jpg", red, 3, OIIO::TypeDesc::UINT8, "jpeg");
-  write_test_image(dir / "r.jpg", blue, 3, OIIO::TypeDesc::UINT8, "jpeg");
-  write_file(dir / "camera.mpo", read_file(dir / "l.jpg") + read_file(dir / "r.jpg"));
-}
-
 // A still's problems, read by the still driver in play as in convert: the same one line and status.
 TEST(PlayCliErrors, AStillsProblemsAsConvertSaysThem) {
   TempDir dir;
@@ -380,8 +364,8 @@ TEST(PlayOffscreen, PlaysWithoutADisplayServerAndPrintsTheSummary) {
   EXPECT_GT(std::chrono::steady_clock::now() - started, std::chrono::seconds(2));
 }
 
-// A stereo photo plays off screen as its one frame, read by the still driver (OpenImageIO), for the
-// frame period a still always had in play.
+// A stereo photo plays off screen as its one frame, read by the still driver (OpenImageIO), for
+// --image-duration.
 TEST(PlayOffscreen, PlaysAJpsAndAnMpoAsTheirOneFrame) {
   TempDir dir;
   write_stereo_photos(dir);
@@ -392,7 +376,7 @@ TEST(PlayOffscreen, PlaysAJpsAndAnMpoAsTheirOneFrame) {
   for (const auto& [name, described] : cases) {
     SCOPED_TRACE(name);
     const auto r = run_command("env -u DISPLAY LP_NUM_THREADS=2 " + std::string(NELF_BINARY) + " play " +
-                               q(dir / name) + " --output offscreen --no-audio");
+                               q(dir / name) + " --output offscreen --no-audio --image-duration 0.1 < /dev/null");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find(described), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("nelf: 1 frames shown, 0 repeated, 0 dropped\n"), std::string::npos) << r.err;

@@ -112,4 +112,20 @@ inline std::string mpo_with_index(const std::string& left, const std::string& ga
   return left.substr(0, 2) + segment + left.substr(2) + gap + right;
 }
 
+// A JPS (right view first) and an MPO (two JPEGs), written for the test.
+inline void write_stereo_photos(const TempDir& dir) {
+  const Image red = filled_image(32, 18, {0.75f, 0.2f, 0.1f, 1.f}),
+              blue = filled_image(32, 18, {0.1f, 0.25f, 0.75f, 1.f});
+  Image jps(64, 18);
+  for (int y = 0; y < 18; ++y)
+    for (int x = 0; x < 32; ++x) {
+      jps.at(x, y) = blue.at(x, y);
+      jps.at(32 + x, y) = red.at(x, y);
+    }
+  write_test_image(dir / "photo.jps", jps, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  write_test_image(dir / "l.jpg", red, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  write_test_image(dir / "r.jpg", blue, 3, OIIO::TypeDesc::UINT8, "jpeg");
+  write_file(dir / "camera.mpo", read_file(dir / "l.jpg") + read_file(dir / "r.jpg"));
+}
+
 }  // namespace nelf::test

@@ -57,8 +57,8 @@ TEST_F(PlayerWindowTest, ClosingTheWindowEndsPlaybackCleanly) {
   EXPECT_EQ(result.counters.shown, 3);
 }
 
-// A stereo photo plays as its one frame, read as convert reads it (the still driver): a JPS (right
-// view first) and an MPO (two JPEGs) both show the left view to the left eye, in the window too.
+// A stereo photo plays as its one frame (for --image-duration), read as convert reads it (the still driver): a JPS
+// (right view first) and an MPO (two JPEGs) both show the left view to the left eye, in the window too.
 TEST_F(PlayerWindowTest, AStereoPhotoShowsEachEyesView) {
   const Image red = test::filled_image(320, 180, {0.75f, 0.2f, 0.1f, 1.f});
   const Image blue = test::filled_image(320, 180, {0.1f, 0.25f, 0.75f, 1.f});
@@ -74,6 +74,7 @@ TEST_F(PlayerWindowTest, AStereoPhotoShowsEachEyesView) {
   test::write_file(dir_ / "camera.mpo", test::read_file(dir_ / "l.jpg") + test::read_file(dir_ / "r.jpg"));
 
   PlayerOptions options = silent_options();
+  options.image_duration_s = 0.1;  // else a photo stays until a key
   auto display = open_display(options);
   const auto left = *eye_area(options.signal, Eye::left, 160, 90);
   const auto right = *eye_area(options.signal, Eye::right, 160, 90);
