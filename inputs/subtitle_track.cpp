@@ -40,16 +40,6 @@ std::string av_error(int code) {
   return text;
 }
 
-// One bitmap rectangle of a bitmap subtitle, straight RGBA8 in the codec's canvas.
-struct BitmapRect {
-  int x = 0, y = 0, width = 0, height = 0;
-  std::vector<std::uint8_t> rgba;
-};
-struct BitmapEvent {
-  double start_s = 0.0, end_s = std::numeric_limits<double>::infinity();
-  std::vector<BitmapRect> rects;
-};
-
 // "over" of a premultiplied source colour with coverage `a` (0..255) onto premultiplied `dst`.
 void blend_premultiplied(std::uint8_t* dst, int r, int g, int b, int a) {
   const int keep = 255 - a;
@@ -69,7 +59,6 @@ struct SubtitleTrack::Impl {
   ffmpeg::CodecContextPtr codec;
   ffmpeg::PacketPtr packet{av_packet_alloc()};
   AVStream* stream = nullptr;
-  bool text = false;
   bool at_end = false;
   double read_until_s = -std::numeric_limits<double>::infinity();  // packets read up to here
   double last_asked_s = -std::numeric_limits<double>::infinity();
@@ -79,8 +68,6 @@ struct SubtitleTrack::Impl {
   std::unique_ptr<ASS_Track, AssTrackDeleter> track;
   int frame_w = 0, frame_h = 0;
   double pixel_aspect = 0.0;
-  // Bitmaps, in start order.
-  std::vector<BitmapEvent> bitmaps;
 
   [[noreturn]] void fail(const std::string& why) const {
     throw UserError(fmt::format("{}: {}", printable(path), why), 1);
@@ -110,23 +97,24 @@ struct SubtitleTrack::Impl {
     if (const int err = avcodec_open2(codec.get(), decoder, nullptr); err < 0)
       fail(fmt::format("cannot open the {} decoder: {}", decoder->name, av_error(err)));
     const AVCodecDescriptor* descriptor = avcodec_descriptor_get(stream->codecpar->codec_id);
-    text = descriptor && (descriptor->props & AV_CODEC_PROP_TEXT_SUB) != 0;
+    // Bitmap tracks (PGS, DVB, VobSub) decode too, but their drawing is not written yet.
+    if (!descriptor || (descriptor->props & AV_CODEC_PROP_TEXT_SUB) == 0)
+      fail(fmt::format("{} subtitles are bitmaps, which are not drawn yet; text subtitles (SRT, ASS/SSA, WebVTT) are",
+                       decoder->name));
     description = fmt::format("subtitles: {} ({})", path, decoder->name);
-    if (text) {
-      library.reset(ass_library_init());
-      if (!library) fail("libass cannot start");
-      ass_set_message_cb(
-          library.get(), [](int, const char*, va_list, void*) {}, nullptr);
-      ass_set_extract_fonts(library.get(), 1);
-      renderer.reset(ass_renderer_init(library.get()));
-      if (!renderer) fail("libass cannot start its renderer");
-      ass_set_fonts(renderer.get(), nullptr, "sans-serif", ASS_FONTPROVIDER_AUTODETECT, nullptr, 1);
-      track.reset(ass_new_track(library.get()));
-      if (!track) fail("libass cannot make a track");
-      if (codec->subtitle_header && codec->subtitle_header_size > 0)
-        ass_process_codec_private(track.get(), reinterpret_cast<char*>(codec->subtitle_header),
-                                  codec->subtitle_header_size);
-    }
+    library.reset(ass_library_init());
+    if (!library) fail("libass cannot start");
+    ass_set_message_cb(
+        library.get(), [](int, const char*, va_list, void*) {}, nullptr);
+    ass_set_extract_fonts(library.get(), 1);
+    renderer.reset(ass_renderer_init(library.get()));
+    if (!renderer) fail("libass cannot start its renderer");
+    ass_set_fonts(renderer.get(), nullptr, "sans-serif", ASS_FONTPROVIDER_AUTODETECT, nullptr, 1);
+    track.reset(ass_new_track(library.get()));
+    if (!track) fail("libass cannot make a track");
+    if (codec->subtitle_header && codec->subtitle_header_size > 0)
+      ass_process_codec_private(track.get(), reinterpret_cast<char*>(codec->subtitle_header),
+                                codec->subtitle_header_size);
     // A subtitle file that does not parse is refused now, not at its first line: every packet of
     // it is decoded up front (an external file is small; a movie's stream is read as it plays).
     read_to(first_packet_horizon());
@@ -154,38 +142,13 @@ struct SubtitleTrack::Impl {
       end = seconds(pts + p.duration);
     else if (owned->end_display_time > owned->start_display_time && owned->end_display_time != UINT32_MAX)
       end = seconds(pts) + owned->end_display_time / 1000.0;
-    if (text) {
-      const double duration = std::isfinite(end) ? end - start : 3600.0;
-      for (unsigned i = 0; i < owned->num_rects; ++i) {
-        const AVSubtitleRect& rect = *owned->rects[i];
-        if (rect.type != SUBTITLE_ASS || !rect.ass) continue;
-        ass_process_chunk(track.get(), rect.ass, static_cast<int>(std::strlen(rect.ass)), std::llround(start * 1000.0),
-                          std::llround(duration * 1000.0));
-      }
-      return;
-    }
-    // A bitmap event lasts until its own end or the next event (an empty one clears the screen).
-    if (!bitmaps.empty()) bitmaps.back().end_s = std::min(bitmaps.back().end_s, start);
-    BitmapEvent event{start, end, {}};
+    const double duration = std::isfinite(end) ? end - start : 3600.0;
     for (unsigned i = 0; i < owned->num_rects; ++i) {
       const AVSubtitleRect& rect = *owned->rects[i];
-      if (rect.type != SUBTITLE_BITMAP || rect.w <= 0 || rect.h <= 0 || !rect.data[0] || !rect.data[1]) continue;
-      BitmapRect out{rect.x, rect.y, rect.w, rect.h, {}};
-      out.rgba.resize(static_cast<std::size_t>(rect.w) * rect.h * 4);
-      const auto* palette = reinterpret_cast<const std::uint32_t*>(rect.data[1]);  // native-endian ARGB
-      for (int y = 0; y < rect.h; ++y)
-        for (int x = 0; x < rect.w; ++x) {
-          const std::uint8_t index = rect.data[0][static_cast<std::size_t>(y) * rect.linesize[0] + x];
-          const std::uint32_t argb = index < rect.nb_colors ? palette[index] : 0;
-          std::uint8_t* px = &out.rgba[(static_cast<std::size_t>(y) * rect.w + x) * 4];
-          px[0] = static_cast<std::uint8_t>(argb >> 16);
-          px[1] = static_cast<std::uint8_t>(argb >> 8);
-          px[2] = static_cast<std::uint8_t>(argb);
-          px[3] = static_cast<std::uint8_t>(argb >> 24);
-        }
-      event.rects.push_back(std::move(out));
+      if (rect.type != SUBTITLE_ASS || !rect.ass) continue;
+      ass_process_chunk(track.get(), rect.ass, static_cast<int>(std::strlen(rect.ass)), std::llround(start * 1000.0),
+                        std::llround(duration * 1000.0));
     }
-    bitmaps.push_back(std::move(event));
   }
 
   // Reads packets until one starts after `t_s` (kept for later) or the stream ends.
@@ -213,8 +176,7 @@ struct SubtitleTrack::Impl {
     const auto ts = static_cast<std::int64_t>((from + offset_s) * AV_TIME_BASE);
     if (avformat_seek_file(format.get(), -1, std::numeric_limits<std::int64_t>::min(), ts, ts, 0) < 0) return;
     avcodec_flush_buffers(codec.get());
-    if (track) ass_flush_events(track.get());
-    bitmaps.clear();
+    ass_flush_events(track.get());
     at_end = false;
     read_until_s = -std::numeric_limits<double>::infinity();
   }
@@ -252,54 +214,6 @@ struct SubtitleTrack::Impl {
           blend_premultiplied(&out.rgba[(static_cast<std::size_t>(oy) * out.width + ox) * 4], r, g, b, a);
         }
       }
-    }
-  }
-
-  // The bitmap canvas (the codec's frame size) spread over the view as it is displayed: each view
-  // pixel takes the mean of the canvas pixels it covers.
-  void render_bitmaps(double t_s, SubtitleBitmap& out) {
-    const BitmapEvent* shown = nullptr;
-    for (const BitmapEvent& e : bitmaps)
-      if (e.start_s <= t_s && t_s < e.end_s) shown = &e;
-    if (!shown || shown->rects.empty()) return;
-    int canvas_w = codec->width, canvas_h = codec->height;
-    if (canvas_w <= 0 || canvas_h <= 0) {
-      canvas_w = 720;  // DVB's default display definition
-      canvas_h = 576;
-    }
-    out.rgba.assign(static_cast<std::size_t>(out.width) * out.height * 4, 0);
-    const double sx = static_cast<double>(canvas_w) / out.width, sy = static_cast<double>(canvas_h) / out.height;
-    for (const BitmapRect& rect : shown->rects) {
-      const int x0 = std::max(0, static_cast<int>(std::floor(rect.x / sx)));
-      const int x1 = std::min(out.width, static_cast<int>(std::ceil((rect.x + rect.width) / sx)));
-      const int y0 = std::max(0, static_cast<int>(std::floor(rect.y / sy)));
-      const int y1 = std::min(out.height, static_cast<int>(std::ceil((rect.y + rect.height) / sy)));
-      for (int oy = y0; oy < y1; ++oy)
-        for (int ox = x0; ox < x1; ++ox) {
-          const int cx0 = std::max(rect.x, static_cast<int>(std::floor(ox * sx)));
-          const int cx1 = std::min(rect.x + rect.width, std::max(cx0 + 1, static_cast<int>(std::floor((ox + 1) * sx))));
-          const int cy0 = std::max(rect.y, static_cast<int>(std::floor(oy * sy)));
-          const int cy1 =
-              std::min(rect.y + rect.height, std::max(cy0 + 1, static_cast<int>(std::floor((oy + 1) * sy))));
-          long sum[4] = {0, 0, 0, 0};
-          long n = 0;
-          for (int cy = cy0; cy < cy1; ++cy)
-            for (int cx = cx0; cx < cx1; ++cx) {
-              const std::uint8_t* p =
-                  &rect.rgba[(static_cast<std::size_t>(cy - rect.y) * rect.width + (cx - rect.x)) * 4];
-              sum[0] += p[0] * p[3];
-              sum[1] += p[1] * p[3];
-              sum[2] += p[2] * p[3];
-              sum[3] += p[3];
-              ++n;
-            }
-          if (n == 0 || sum[3] == 0) continue;
-          const int a = static_cast<int>(sum[3] / n);
-          // Premultiplied means of the covered canvas pixels, drawn over what other rects left.
-          const auto channel = [&](long s) { return a == 0 ? 0 : static_cast<int>(s / n / a); };
-          blend_premultiplied(&out.rgba[(static_cast<std::size_t>(oy) * out.width + ox) * 4], channel(sum[0]),
-                              channel(sum[1]), channel(sum[2]), a);
-        }
     }
   }
 };
@@ -358,10 +272,7 @@ SubtitleBitmap SubtitleTrack::render(double t_s, int width, int height, double a
   out.height = height;
   if (width <= 0 || height <= 0) return out;
   if (aspect <= 0.0) aspect = static_cast<double>(width) / height;
-  if (m.text)
-    m.render_text(t_s, out, aspect);
-  else
-    m.render_bitmaps(t_s, out);
+  m.render_text(t_s, out, aspect);
   return out;
 }
 

@@ -1,9 +1,8 @@
 #pragma once
-// A subtitle stream of a media file (the movie itself, or an external .srt/.ass/.vtt/.sup file),
-// decoded by libavcodec: text events are laid out and rasterised by libass with their styling,
-// bitmap events (PGS, DVB, VobSub) are converted from their palettes. Read forward as the times
-// asked for advance (a seek back or far ahead seeks the file), so opening a long movie reads
-// nothing in advance.
+// A text subtitle stream of a media file (the movie itself, or an external .srt/.ass/.vtt file),
+// decoded by libavcodec and laid out and rasterised by libass with its styling. Read forward as
+// the times asked for advance (a seek back or far ahead seeks the file), so opening a long movie
+// reads nothing in advance.
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,7 +17,8 @@ class SubtitleTrack {
   // The first subtitle stream of `path` (a movie or a subtitle file). The caller's time 0 is the
   // movie's `start_s` (--start): a movie's own subtitles are timed on its video's clock (from its
   // start time), a subtitle file's from the start of the movie. Throws UserError (one line) when
-  // the file cannot be read, has no subtitle stream that FFmpeg decodes, or does not parse.
+  // the file cannot be read, has no subtitle stream that FFmpeg decodes, does not parse, or has
+  // bitmap subtitles (PGS, DVB, VobSub: not drawn yet).
   SubtitleTrack(const std::string& path, double start_s);
   ~SubtitleTrack();
   SubtitleTrack(const SubtitleTrack&) = delete;

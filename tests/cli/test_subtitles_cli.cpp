@@ -97,6 +97,17 @@ TEST_F(SubtitlesCli, ParallaxMovesTheTextInBothEyes) {
   EXPECT_GT(differing(on_screen, in_front, half, on_screen.width), 20);
 }
 
+TEST_F(SubtitlesCli, StartKeepsTheSubtitlesOnTheMoviesClock) {
+  write_file(dir_ / "late.srt", "1\n00:00:00,500 --> 00:00:00,800\nLATE LINE\n\n");
+  const std::string late = "--burn-subs --sub-file " + q(dir_ / "late.srt");
+  EXPECT_EQ(convert(dir_ / "plain.mp4", "before.png", late).rgb, convert(dir_ / "plain.mp4", "plain.png", "").rgb);
+  const Packed on = convert(dir_ / "plain.mp4", "on.png", late + " --start 0.6");
+  const Packed plain_on = convert(dir_ / "plain.mp4", "plain_on.png", "--start 0.6");
+  EXPECT_GT(differing(on, plain_on, 0, on.width), 50);
+  EXPECT_EQ(convert(dir_ / "plain.mp4", "after.png", late + " --start 0.9").rgb,
+            convert(dir_ / "plain.mp4", "plain_after.png", "--start 0.9").rgb);
+}
+
 TEST_F(SubtitlesCli, BadSubtitleInputIsOneLineAndNoOutput) {
   const std::string tail = " --layout sbs --signal sbs --profile " + q(profile_);
   const auto out = q(out_ / "out.png");
