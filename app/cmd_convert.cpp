@@ -39,6 +39,9 @@ struct ConvertArgs : CommonArgs {
   std::optional<double> start, duration;
   std::optional<long> frames;
   bool no_audio = false, quiet = false, strict = false;
+  bool burn_subs = false;
+  std::string sub_file;
+  std::optional<double> sub_parallax;
 };
 
 // Inputs the still driver reads (OpenImageIO) become one image; everything else (and `synthetic:`)
@@ -111,6 +114,9 @@ void write_packed_still_raw(const StereoPair& views, const ConvertPlan& plan) {
   sink->finish();
 }
 
+// More than this pulls the two copies so far apart that the eyes no longer fuse them.
+constexpr double kMaxSubParallax = 10.0;
+
 void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
   VideoConvertRequest r;
   r.inputs = inputs;
@@ -152,6 +158,16 @@ void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
           fmt::format("{} holds one frame; for --duration name an image sequence such as {}", args.output, pattern), 2);
     r.max_frames = 1;
   }
+  if (!args.burn_subs && !args.sub_file.empty()) throw UserError("--sub-file needs --burn-subs", 2);
+  if (!args.burn_subs && args.sub_parallax) throw UserError("--sub-parallax needs --burn-subs", 2);
+  if (args.burn_subs) {
+    const double parallax = args.sub_parallax.value_or(0.0);
+    if (!std::isfinite(parallax) || std::abs(parallax) > kMaxSubParallax)
+      throw UserError(fmt::format("--sub-parallax must be -{0}..{0} (percent of the view width), got {1}",
+                                  kMaxSubParallax, parallax),
+                      2);
+    r.burn_subs = SubtitleBurn{args.sub_file, parallax};
+  }
   r.quiet = args.quiet;
   r.strict = args.strict;
   r.allow_network = args.allow_network;
@@ -181,8 +197,11 @@ void run_convert(const ConvertArgs& args) {
   inputs.add(args.input, "the input");
   inputs.add(args.right, "the --right view");
   inputs.add(args.profile, "the --profile");
+  inputs.add(args.sub_file, "the --sub-file");
   if (!is_raw_output(args.output)) inputs.refuse_as_output(args.output);
   if (!is_still_image(args.input)) return run_convert_video(args, inputs);
+  if (args.burn_subs)
+    throw UserError(fmt::format("{}: --burn-subs is for video; a still has no subtitles", args.input), 2);
   if (is_raw_output(args.output)) refuse_options_raw_cannot_apply(args);
   const ConvertPlan plan = plan_convert(args);
   // Read as play reads it (the still driver); composed from its float views, not the frame's bytes.
@@ -346,6 +365,14 @@ void add_convert_command(CLI::App& app) {
   cmd->add_flag("--no-audio", args->no_audio, "Video: leave the audio out");
   cmd->add_flag("--quiet", args->quiet, "Video: no progress output (warnings are still printed)");
   cmd->add_flag("--strict", args->strict, "Video: a damaged or truncated input is an error");
+  cmd->add_flag("--burn-subs", args->burn_subs,
+                "Video: draw subtitles into both eyes (--sub-file, else INPUT.srt/.ass/.vtt beside the input, else "
+                "the input's first subtitle track)");
+  cmd->add_option("--sub-file", args->sub_file,
+                  "Video, with --burn-subs: the subtitle file (SRT, ASS/SSA, WebVTT, ...)");
+  cmd->add_option("--sub-parallax", args->sub_parallax,
+                  "Video, with --burn-subs: the subtitles' depth in percent of the view width (positive = in front "
+                  "of the screen; default 0, on it)");
   cmd->callback([args] { run_convert(*args); });
 }
 

@@ -20,8 +20,8 @@ packages=(
   ffmpeg libopenimageio-dev libpng-dev
   # stereo matching for the estimated depth (inputs/stereo_matcher): OpenCV's block matcher
   libopencv-dev
-  # maths, configuration, CLI, formatting, JSON, audio
-  libglm-dev libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libsdl2-dev
+  # maths, configuration, CLI, formatting, JSON, audio, subtitles (libass)
+  libglm-dev libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libsdl2-dev libass-dev
   # tests (zsh and fish: the completion checks run them)
   libgtest-dev libgmock-dev zsh fish
   # the package checks (tests/package): the man page rendered as lintian does, lintian itself,

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <csignal>
 #include <exception>
+#include <filesystem>
 #include <future>
 #include <mutex>
 #include <thread>
@@ -19,12 +20,14 @@ extern "C" {
 
 #include "compositor/frame_compositor.hpp"
 #include "compositor/gl/gl_compositor.hpp"
+#include "compositor/overlays/subtitle_overlay.hpp"
 #include "core/bounded_queue.hpp"
 #include "core/ffmpeg_raii.hpp"
 #include "core/user_error.hpp"
 #include "hmz_output/file_sink_drivers.hpp"
 #include "hmz_output/packing.hpp"
 #include "inputs/source_drivers.hpp"
+#include "inputs/subtitle_track.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
@@ -105,13 +108,42 @@ std::unique_ptr<FrameSink> open_frame_sink(const VideoConvertRequest& r, Source&
   return driver.open_file(std::move(request));
 }
 
+// The track --burn-subs draws: --sub-file, else a subtitle file beside the input (movie.srt,
+// movie.en.srt, …), else the input's own first subtitle stream. Opened (and a subtitle file parsed)
+// before any output exists.
+std::unique_ptr<SubtitleTrack> open_burned_subtitles(const VideoConvertRequest& r) {
+  const SubtitleBurn& burn = *r.burn_subs;
+  std::string file = burn.file;
+  if (file.empty()) {
+    const std::vector<std::string> beside = SubtitleTrack::beside(r.input);
+    if (!beside.empty())
+      file = beside.front();
+    else if (SubtitleTrack::has_subtitles(r.input))
+      file = r.input;
+    else
+      throw UserError(fmt::format("{}: no subtitles to burn in (no subtitle stream, no subtitle file beside it; "
+                                  "--sub-file FILE names one)",
+                                  printable(r.input)),
+                      1);
+  }
+  auto track = std::make_unique<SubtitleTrack>(file, r.start_s.value_or(0.0));
+  if (!r.quiet) fmt::print(stderr, "nelf: {}\n", printable(track->description()));
+  return track;
+}
+
 }  // namespace
 
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
   SourceRequest request{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels};
   request.stop = &interrupt_requested;
+  // Subtitles before the input (which says a line about itself), so that subtitles that cannot
+  // be burned in are the only line said; an input that is not there is said as such first.
+  std::error_code missing;
+  const bool subtitles_first = r.burn_subs && (!r.burn_subs->file.empty() || std::filesystem::exists(r.input, missing));
+  std::unique_ptr<SubtitleTrack> subtitles = subtitles_first ? open_burned_subtitles(r) : nullptr;
   std::unique_ptr<Source> source = open_source_for_depth(request, r.compositor.depth, r.profile);
+  if (r.burn_subs && !subtitles) subtitles = open_burned_subtitles(r);
   // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
   const ViewGeometry view = source->info().view;
   source->negotiate({stereo_prefilter_block(r.profile, r.compositor, view.width, view.height, view.aspect)});
@@ -150,6 +182,10 @@ void convert_video(const VideoConvertRequest& r) {
         if (r.duration_s && frame->pts_s >= *r.duration_s - 1e-9) break;
         if (frame->width != view_w || frame->height != view_h || frame->bits != bits || frame->block != block)
           throw UserError(fmt::format("{}: the frame size changed mid-stream", r.input), 1);
+        if (subtitles) {
+          const auto [w, h] = subtitle_canvas(*frame);
+          draw_subtitles(*frame, subtitles->render(frame->pts_s, w, h, frame->aspect), r.burn_subs->parallax_percent);
+        }
         if (!decoded.push(std::move(*frame))) return;
         // Not one frame more than --frames is asked of the source: a live one may wait long for it.
         if (r.max_frames && ++count >= *r.max_frames) break;

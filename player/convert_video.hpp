@@ -13,6 +13,12 @@
 
 namespace nelf {
 
+// `--burn-subs`: a subtitle track drawn into both views of every frame before compositing.
+struct SubtitleBurn {
+  std::string file;               // --sub-file; "" = a subtitle file beside the input, else its own track
+  double parallax_percent = 0.0;  // --sub-parallax: of the view width, positive = in front of the screen
+};
+
 struct VideoConvertRequest {
   std::string input;  // a media file or `synthetic:[options]`
   std::string right;  // second input for layout pair
@@ -32,6 +38,7 @@ struct VideoConvertRequest {
   bool strict = false;
   bool allow_network = false;
   std::int64_t max_pixels = kDefaultMaxPixels;
+  std::optional<SubtitleBurn> burn_subs;
 };
 
 // Runs the conversion. Throws UserError (status 1 for failed jobs, 130 when interrupted); leaves no

@@ -1,0 +1,26 @@
+#pragma once
+// Subtitles drawn into both views before compositing, so that they are seen in focus through the
+// lenses like the movie, and at a depth: the two copies are shifted horizontally in opposite
+// directions, as a 3D Blu-ray player offsets its subtitle plane.
+#include <array>
+
+#include "core/frames.hpp"
+#include "core/subtitle_bitmap.hpp"
+
+namespace nelf {
+
+// The size of the view pixels a subtitle for `frame` is drawn for: the views' full size, or the
+// size of their block means when the frame carries those.
+std::array<int, 2> subtitle_canvas(const StereoVideoFrame& frame);
+
+// The horizontal shift of each eye's copy in view pixels for `parallax_percent` of a view
+// `width` pixels wide: the left eye's copy moves right by it, the right eye's left.
+int subtitle_shift(double parallax_percent, int width);
+
+// `subtitle` (subtitle_canvas(frame) in size; an empty one draws nothing) drawn over both views of
+// `frame` (8 or 16 bits a channel), the left eye's copy `parallax_percent` of the view width to the
+// right of the right eye's: positive puts the text in front of the screen, 0 on it. Parts shifted
+// out of a view are cut off. Throws std::invalid_argument when the sizes differ.
+void draw_subtitles(StereoVideoFrame& frame, const SubtitleBitmap& subtitle, double parallax_percent);
+
+}  // namespace nelf

@@ -1,0 +1,17 @@
+#pragma once
+// A subtitle as drawn for one view: what a subtitle track renders (inputs/) and the compositor's
+// overlays draw into both views (compositor/overlays/subtitle_overlay) meet here.
+#include <cstdint>
+#include <vector>
+
+namespace nelf {
+
+// `width`×`height` pixels of RGBA8, premultiplied by alpha (so that drawing it is one
+// multiply-add a channel), row 0 the top row: the size of the view pixels it is drawn over.
+struct SubtitleBitmap {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;
+  bool empty() const { return rgba.empty(); }
+};
+
+}  // namespace nelf

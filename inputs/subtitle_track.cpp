@@ -1,0 +1,281 @@
+#include "inputs/subtitle_track.hpp"
+
+#include <ass/ass.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <vector>
+
+#include "core/ffmpeg_raii.hpp"
+#include "core/printable.hpp"
+#include "core/user_error.hpp"
+
+namespace nelf {
+namespace {
+
+struct AssLibraryDeleter {
+  void operator()(ASS_Library* library) const { ass_library_done(library); }
+};
+struct AssRendererDeleter {
+  void operator()(ASS_Renderer* renderer) const { ass_renderer_done(renderer); }
+};
+struct AssTrackDeleter {
+  void operator()(ASS_Track* track) const { ass_free_track(track); }
+};
+struct SubtitleDeleter {
+  void operator()(AVSubtitle* subtitle) const {
+    avsubtitle_free(subtitle);
+    delete subtitle;
+  }
+};
+
+std::string av_error(int code) {
+  char text[AV_ERROR_MAX_STRING_SIZE] = {};
+  av_strerror(code, text, sizeof text);
+  return text;
+}
+
+// "over" of a premultiplied source colour with coverage `a` (0..255) onto premultiplied `dst`.
+void blend_premultiplied(std::uint8_t* dst, int r, int g, int b, int a) {
+  const int keep = 255 - a;
+  dst[0] = static_cast<std::uint8_t>((r * a + dst[0] * keep + 127) / 255);
+  dst[1] = static_cast<std::uint8_t>((g * a + dst[1] * keep + 127) / 255);
+  dst[2] = static_cast<std::uint8_t>((b * a + dst[2] * keep + 127) / 255);
+  dst[3] = static_cast<std::uint8_t>((255 * a + dst[3] * keep + 127) / 255);
+}
+
+}  // namespace
+
+struct SubtitleTrack::Impl {
+  std::string path;
+  double offset_s = 0.0;
+  std::string description;
+  ffmpeg::FormatContextPtr format;
+  ffmpeg::CodecContextPtr codec;
+  ffmpeg::PacketPtr packet{av_packet_alloc()};
+  AVStream* stream = nullptr;
+  bool at_end = false;
+  double read_until_s = -std::numeric_limits<double>::infinity();  // packets read up to here
+  double last_asked_s = -std::numeric_limits<double>::infinity();
+  // Text: libass.
+  std::unique_ptr<ASS_Library, AssLibraryDeleter> library;
+  std::unique_ptr<ASS_Renderer, AssRendererDeleter> renderer;
+  std::unique_ptr<ASS_Track, AssTrackDeleter> track;
+  int frame_w = 0, frame_h = 0;
+  double pixel_aspect = 0.0;
+
+  [[noreturn]] void fail(const std::string& why) const {
+    throw UserError(fmt::format("{}: {}", printable(path), why), 1);
+  }
+
+  void open() {
+    AVFormatContext* raw = nullptr;
+    if (const int err = avformat_open_input(&raw, path.c_str(), nullptr, nullptr); err < 0)
+      fail(fmt::format("cannot open subtitles: {}", av_error(err)));
+    format.reset(raw);
+    if (const int err = avformat_find_stream_info(format.get(), nullptr); err < 0)
+      fail(fmt::format("cannot read subtitles: {}", av_error(err)));
+    const int index = av_find_best_stream(format.get(), AVMEDIA_TYPE_SUBTITLE, -1, -1, nullptr, 0);
+    if (index < 0) fail("no subtitle stream");
+    stream = format->streams[index];
+    // A movie's subtitles share its video's clock, whose first frame is time 0.
+    const int video = av_find_best_stream(format.get(), AVMEDIA_TYPE_VIDEO, -1, -1, nullptr, 0);
+    if (video >= 0 && format->streams[video]->start_time != AV_NOPTS_VALUE)
+      offset_s += static_cast<double>(format->streams[video]->start_time) * av_q2d(format->streams[video]->time_base);
+    for (unsigned i = 0; i < format->nb_streams; ++i)
+      if (static_cast<int>(i) != index) format->streams[i]->discard = AVDISCARD_ALL;
+    const AVCodec* decoder = avcodec_find_decoder(stream->codecpar->codec_id);
+    if (!decoder) fail(fmt::format("no decoder for subtitles in {}", avcodec_get_name(stream->codecpar->codec_id)));
+    codec.reset(avcodec_alloc_context3(decoder));
+    if (!codec || avcodec_parameters_to_context(codec.get(), stream->codecpar) < 0) fail("cannot set up the decoder");
+    codec->pkt_timebase = stream->time_base;
+    if (const int err = avcodec_open2(codec.get(), decoder, nullptr); err < 0)
+      fail(fmt::format("cannot open the {} decoder: {}", decoder->name, av_error(err)));
+    const AVCodecDescriptor* descriptor = avcodec_descriptor_get(stream->codecpar->codec_id);
+    // Bitmap tracks (PGS, DVB, VobSub) decode too, but their drawing is not written yet.
+    if (!descriptor || (descriptor->props & AV_CODEC_PROP_TEXT_SUB) == 0)
+      fail(fmt::format("{} subtitles are bitmaps, which are not drawn yet; text subtitles (SRT, ASS/SSA, WebVTT) are",
+                       decoder->name));
+    description = fmt::format("subtitles: {} ({})", path, decoder->name);
+    library.reset(ass_library_init());
+    if (!library) fail("libass cannot start");
+    ass_set_message_cb(
+        library.get(), [](int, const char*, va_list, void*) {}, nullptr);
+    ass_set_extract_fonts(library.get(), 1);
+    renderer.reset(ass_renderer_init(library.get()));
+    if (!renderer) fail("libass cannot start its renderer");
+    ass_set_fonts(renderer.get(), nullptr, "sans-serif", ASS_FONTPROVIDER_AUTODETECT, nullptr, 1);
+    track.reset(ass_new_track(library.get()));
+    if (!track) fail("libass cannot make a track");
+    if (codec->subtitle_header && codec->subtitle_header_size > 0)
+      ass_process_codec_private(track.get(), reinterpret_cast<char*>(codec->subtitle_header),
+                                codec->subtitle_header_size);
+    // A subtitle file that does not parse is refused now, not at its first line: every packet of
+    // it is decoded up front (an external file is small; a movie's stream is read as it plays).
+    read_to(first_packet_horizon());
+  }
+
+  // External files hold only subtitles: read them whole. A movie: what its first seconds hold.
+  double first_packet_horizon() const {
+    return format->nb_streams == 1 ? std::numeric_limits<double>::infinity() : 0.0;
+  }
+
+  double seconds(std::int64_t ts) const { return static_cast<double>(ts) * av_q2d(stream->time_base) - offset_s; }
+
+  void decode(AVPacket& p) {
+    AVSubtitle sub{};
+    int got = 0;
+    const int err = avcodec_decode_subtitle2(codec.get(), &sub, &got, &p);
+    if (err < 0) fail(fmt::format("subtitles do not decode: {}", av_error(err)));
+    if (!got) return;
+    const std::unique_ptr<AVSubtitle, SubtitleDeleter> owned(new AVSubtitle(sub));
+    const std::int64_t pts = p.pts != AV_NOPTS_VALUE ? p.pts : p.dts;
+    if (pts == AV_NOPTS_VALUE) return;
+    const double start = seconds(pts) + owned->start_display_time / 1000.0;
+    double end = std::numeric_limits<double>::infinity();
+    if (p.duration > 0)
+      end = seconds(pts + p.duration);
+    else if (owned->end_display_time > owned->start_display_time && owned->end_display_time != UINT32_MAX)
+      end = seconds(pts) + owned->end_display_time / 1000.0;
+    const double duration = std::isfinite(end) ? end - start : 3600.0;
+    for (unsigned i = 0; i < owned->num_rects; ++i) {
+      const AVSubtitleRect& rect = *owned->rects[i];
+      if (rect.type != SUBTITLE_ASS || !rect.ass) continue;
+      ass_process_chunk(track.get(), rect.ass, static_cast<int>(std::strlen(rect.ass)), std::llround(start * 1000.0),
+                        std::llround(duration * 1000.0));
+    }
+  }
+
+  // Reads packets until one starts after `t_s` (kept for later) or the stream ends.
+  void read_to(double t_s) {
+    while (!at_end && read_until_s <= t_s) {
+      const int err = av_read_frame(format.get(), packet.get());
+      if (err == AVERROR_EOF) {
+        at_end = true;
+        break;
+      }
+      if (err < 0) fail(fmt::format("cannot read subtitles: {}", av_error(err)));
+      if (packet->stream_index == stream->index) {
+        const std::int64_t pts = packet->pts != AV_NOPTS_VALUE ? packet->pts : packet->dts;
+        if (pts != AV_NOPTS_VALUE) read_until_s = std::max(read_until_s, seconds(pts));
+        decode(*packet);
+      }
+      av_packet_unref(packet.get());
+    }
+  }
+
+  // Back in time, or far ahead of what was read: read again from a little before `t_s`.
+  void seek_to(double t_s) {
+    constexpr double kPreroll = 10.0;  // events that began this long before the seek still show
+    const double from = t_s - kPreroll;
+    const auto ts = static_cast<std::int64_t>((from + offset_s) * AV_TIME_BASE);
+    if (avformat_seek_file(format.get(), -1, std::numeric_limits<std::int64_t>::min(), ts, ts, 0) < 0) return;
+    avcodec_flush_buffers(codec.get());
+    ass_flush_events(track.get());
+    at_end = false;
+    read_until_s = -std::numeric_limits<double>::infinity();
+  }
+
+  void render_text(double t_s, SubtitleBitmap& out, double aspect) {
+    // libass's "pixel aspect" scales glyph widths by its inverse: the storage aspect over the
+    // display aspect (0.5 for a half side-by-side view), as mpv passes it.
+    const double pixel_aspect_now = (static_cast<double>(out.width) / out.height) / aspect;
+    if (out.width != frame_w || out.height != frame_h || pixel_aspect_now != pixel_aspect) {
+      ass_set_frame_size(renderer.get(), out.width, out.height);
+      ass_set_storage_size(renderer.get(), out.width, out.height);
+      ass_set_pixel_aspect(renderer.get(), pixel_aspect_now);
+      frame_w = out.width;
+      frame_h = out.height;
+      pixel_aspect = pixel_aspect_now;
+    }
+    bool drawn = false;
+    for (ASS_Image* image = ass_render_frame(renderer.get(), track.get(), std::llround(t_s * 1000.0), nullptr); image;
+         image = image->next) {
+      const int r = (image->color >> 24) & 0xff, g = (image->color >> 16) & 0xff, b = (image->color >> 8) & 0xff;
+      const int opacity = 255 - static_cast<int>(image->color & 0xff);
+      for (int y = 0; y < image->h; ++y) {
+        const int oy = image->dst_y + y;
+        if (oy < 0 || oy >= out.height) continue;
+        for (int x = 0; x < image->w; ++x) {
+          const int ox = image->dst_x + x;
+          if (ox < 0 || ox >= out.width) continue;
+          const int coverage = image->bitmap[static_cast<std::size_t>(y) * image->stride + x];
+          if (coverage == 0) continue;
+          if (!drawn) {
+            out.rgba.assign(static_cast<std::size_t>(out.width) * out.height * 4, 0);
+            drawn = true;
+          }
+          const int a = (coverage * opacity + 127) / 255;
+          blend_premultiplied(&out.rgba[(static_cast<std::size_t>(oy) * out.width + ox) * 4], r, g, b, a);
+        }
+      }
+    }
+  }
+};
+
+SubtitleTrack::SubtitleTrack(const std::string& path, double start_s) : impl_(std::make_unique<Impl>()) {
+  impl_->path = path;
+  impl_->offset_s = start_s;
+  impl_->open();
+}
+
+SubtitleTrack::~SubtitleTrack() = default;
+
+std::vector<std::string> SubtitleTrack::beside(const std::string& movie) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path path(movie);
+  if (!fs::is_regular_file(path, ec)) return {};
+  const std::string stem = path.stem().string();
+  const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  std::vector<std::string> exact, with_language;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder, ec)) {
+    const fs::path& candidate = entry.path();
+    std::string ext = candidate.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (ext != ".srt" && ext != ".ass" && ext != ".ssa" && ext != ".vtt") continue;
+    const std::string name = candidate.stem().string();
+    if (name == stem)
+      exact.push_back(candidate.string());
+    else if (name.size() > stem.size() + 1 && name.compare(0, stem.size() + 1, stem + ".") == 0)
+      with_language.push_back(candidate.string());
+  }
+  std::sort(exact.begin(), exact.end());
+  std::sort(with_language.begin(), with_language.end());
+  exact.insert(exact.end(), with_language.begin(), with_language.end());
+  return exact;
+}
+
+bool SubtitleTrack::has_subtitles(const std::string& path) {
+  AVFormatContext* raw = nullptr;
+  if (avformat_open_input(&raw, path.c_str(), nullptr, nullptr) < 0) return false;
+  const ffmpeg::FormatContextPtr format(raw);
+  if (avformat_find_stream_info(format.get(), nullptr) < 0) return false;
+  return av_find_best_stream(format.get(), AVMEDIA_TYPE_SUBTITLE, -1, -1, nullptr, 0) >= 0;
+}
+
+SubtitleBitmap SubtitleTrack::render(double t_s, int width, int height, double aspect) {
+  Impl& m = *impl_;
+  constexpr double kFarAhead = 30.0;  // reading forward beyond this is slower than a seek
+  if (t_s < m.last_asked_s - 1e-6 || (!m.at_end && std::isfinite(m.read_until_s) && t_s > m.read_until_s + kFarAhead))
+    if (m.format->nb_streams > 1) m.seek_to(t_s);
+  m.last_asked_s = t_s;
+  // Packets come in decode order: one starting a little after t_s may be what ends the event at t_s.
+  m.read_to(t_s + 1.0);
+  SubtitleBitmap out;
+  out.width = width;
+  out.height = height;
+  if (width <= 0 || height <= 0) return out;
+  if (aspect <= 0.0) aspect = static_cast<double>(width) / height;
+  m.render_text(t_s, out, aspect);
+  return out;
+}
+
+const std::string& SubtitleTrack::description() const { return impl_->description; }
+
+}  // namespace nelf

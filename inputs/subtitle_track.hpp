@@ -1,0 +1,49 @@
+#pragma once
+// A text subtitle stream of a media file (the movie itself, or an external .srt/.ass/.vtt file),
+// decoded by libavcodec and laid out and rasterised by libass with its styling. Read forward as
+// the times asked for advance (a seek back or far ahead seeks the file), so opening a long movie
+// reads nothing in advance.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/subtitle_bitmap.hpp"
+
+namespace nelf {
+
+class SubtitleTrack {
+ public:
+  // The first subtitle stream of `path` (a movie or a subtitle file). The caller's time 0 is the
+  // movie's `start_s` (--start): a movie's own subtitles are timed on its video's clock (from its
+  // start time), a subtitle file's from the start of the movie. Throws UserError (one line) when
+  // the file cannot be read, has no subtitle stream that FFmpeg decodes, does not parse, or has
+  // bitmap subtitles (PGS, DVB, VobSub: not drawn yet).
+  SubtitleTrack(const std::string& path, double start_s);
+  ~SubtitleTrack();
+  SubtitleTrack(const SubtitleTrack&) = delete;
+  SubtitleTrack& operator=(const SubtitleTrack&) = delete;
+
+  // The subtitle files beside `movie` that belong to it, as mpv loads them: the movie's name with
+  // .srt, .ass, .ssa or .vtt for its extension, or with a language before it (movie.en.srt); the
+  // exact name first, then the others in name order.
+  static std::vector<std::string> beside(const std::string& movie);
+
+  // Whether `path` has a subtitle stream (false also when it cannot be opened).
+  static bool has_subtitles(const std::string& path);
+
+  // What is shown at `t_s` (caller's time), drawn for view pixels of `width`×`height` that are
+  // displayed at `aspect` (0 = width / height): text laid out at that aspect, so that a squeezed
+  // (half side-by-side) view does not squeeze the letters. Empty when nothing is shown. Throws
+  // UserError when the stream turns out not to decode.
+  SubtitleBitmap render(double t_s, int width, int height, double aspect);
+
+  // "subtitles: movie.srt (subrip)".
+  const std::string& description() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace nelf
