@@ -2,13 +2,16 @@
 // engine (player/player) on the display --output picks.
 #include <fmt/format.h>
 
+#include <charconv>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "app/commands.hpp"
 #include "app/play_command.hpp"
 #include "core/printable.hpp"
+#include "core/user_error.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/display_drivers.hpp"
 #include "inputs/source_drivers.hpp"
@@ -17,15 +20,31 @@
 #include "player/depth_input.hpp"
 #include "player/interrupt.hpp"
 #include "player/live_display.hpp"
+#include "player/play_sound.hpp"
 #include "player/player.hpp"
 
 namespace nelf::app {
+
+namespace {
+
+// --aid: N (the N-th audio track), auto (the file's default, or --alang's) or no (no sound).
+std::optional<int> audio_track_number(const std::string& aid) {
+  if (aid == "auto" || aid == "no") return std::nullopt;
+  int number = 0;
+  const auto [end, error] = std::from_chars(aid.data(), aid.data() + aid.size(), number);
+  if (error != std::errc() || end != aid.data() + aid.size() || number < 1)
+    throw UserError(fmt::format("--aid {}: a track number from 1, auto or no", printable(aid)), 2);
+  return number;
+}
+
+}  // namespace
 
 PlayEnd play_input(const PlayArgs& args, SourceRequest request) {
   quiet_ffmpeg_logs(true);
   // Off screen, play renders headless like convert, on the GPU --gpu picks.
   if (args.output != "offscreen") refuse_gpu_for_live_output(args.gpu, "play");
   CommonOptions common = parse_common_options(args, false);
+  const std::optional<int> audio_track = audio_track_number(args.aid);
   try {
     display_driver(args.output);
   } catch (const std::invalid_argument& e) {
@@ -51,7 +70,14 @@ PlayEnd play_input(const PlayArgs& args, SourceRequest request) {
   options.profile = common.profile;
   options.signal = common.signal;
   options.compositor = common.compositor;
-  options.audio = !args.no_audio;
+  options.audio = !args.no_audio && args.aid != "no";
+  options.audio_track = audio_track;
+  if (args.aid == "no") options.no_audio_reason = "--aid no";
+  options.audio_languages = args.alang;
+  options.volume = args.volume;
+  options.mute = args.mute;
+  // A track that is not there is said before anything plays.
+  if (options.audio) playback::choose_audio_track(source->audio_tracks(), options.audio_track, options.audio_languages);
   options.log_frames = args.log_frames;
   options.quiet = args.quiet;
 
@@ -78,11 +104,28 @@ void add_play_options(CLI::App& cmd, PlayArgs& args) {
                  "Diagnostics: write a CSV line per presented refresh (pts, clock, audio clock, counters)");
 }
 
+namespace {
+
+// A file's sound: play's own (a game's window has none to choose or set).
+void add_sound_options(CLI::App& cmd, PlayArgs& args) {
+  cmd.add_option("--aid", args.aid, "Audio track: its number (1 = the file's first audio stream), auto or no")
+      ->capture_default_str();
+  cmd.add_option("--alang", args.alang, "Audio track by language, first match wins: eng,ger (ISO 639-2 as tagged)")
+      ->delimiter(',');
+  cmd.add_option("--volume", args.volume, "Volume 0 to 130 (100: as decoded; keys 9 0 / *)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 130.0));
+  cmd.add_flag("--mute", args.mute, "Start muted (key m)");
+}
+
+}  // namespace
+
 void add_play_command(CLI::App& app) {
   auto args = std::make_shared<PlayArgs>();
   auto* cmd = app.add_subcommand("play", "Watch a stereo video on the display (HMD over HDMI, or a preview window)");
   add_input_option(*cmd, *args);
   add_play_options(*cmd, *args);
+  add_sound_options(*cmd, *args);
   cmd->callback([args] {
     SourceRequest request;
     request.input = args->input;

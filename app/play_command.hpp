@@ -3,6 +3,7 @@
 // player on one input (`run` plays its game's window with them).
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 #include "app/commands.hpp"
 #include "inputs/source.hpp"
@@ -15,6 +16,10 @@ struct PlayArgs : CommonArgs {
   std::string monitor;
   std::string connector;
   bool no_audio = false;
+  std::string aid = "auto";  // a track number, auto or no
+  std::vector<std::string> alang;
+  double volume = 100.0;
+  bool mute = false;
   bool quiet = false;
   std::string log_frames;
 };
