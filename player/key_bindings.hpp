@@ -31,6 +31,12 @@ enum class Command {
   swap_eyes,
   calibration_grid,
   fullscreen,
+  next_audio_track,
+  volume_down,
+  volume_up,
+  mute,
+  show_progress,
+  keep_progress,
   // calibrate
   next_eye,
   shift_left,
