@@ -3,16 +3,19 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "app/commands.hpp"
 #include "app/play_command.hpp"
 #include "core/printable.hpp"
+#include "core/user_error.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/display_drivers.hpp"
 #include "inputs/source_drivers.hpp"
@@ -21,6 +24,7 @@
 #include "player/depth_input.hpp"
 #include "player/interrupt.hpp"
 #include "player/live_display.hpp"
+#include "player/play_sound.hpp"
 #include "player/player.hpp"
 #include "player/playlist.hpp"
 #include "player/watch_later.hpp"
@@ -28,6 +32,16 @@
 namespace nelf::app {
 
 namespace {
+
+// --aid: N (the N-th audio track), auto (the file's default, or --alang's) or no (no sound).
+std::optional<int> audio_track_number(const std::string& aid) {
+  if (aid == "auto" || aid == "no") return std::nullopt;
+  int number = 0;
+  const auto [end, error] = std::from_chars(aid.data(), aid.data() + aid.size(), number);
+  if (error != std::errc() || end != aid.data() + aid.size() || number < 1)
+    throw UserError(fmt::format("--aid {}: a track number from 1, auto or no", printable(aid)), 2);
+  return number;
+}
 
 void warn(const std::string& line) { fmt::print(stderr, "nelf: warning: {}\n", printable(line)); }
 
@@ -65,7 +79,14 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
   options.profile = common.profile;
   options.signal = common.signal;
   options.compositor = common.compositor;
-  options.audio = !args.no_audio;
+  options.audio = !args.no_audio && args.aid != "no";
+  options.audio_track = audio_track_number(args.aid);
+  if (args.aid == "no") options.no_audio_reason = "--aid no";
+  options.audio_languages = args.alang;
+  options.volume = args.volume;
+  options.mute = args.mute;
+  // A track that is not there is said before anything plays.
+  if (options.audio) playback::choose_audio_track(source->audio_tracks(), options.audio_track, options.audio_languages);
   options.log_frames = args.log_frames;
   options.quiet = args.quiet;
   options.image_duration_s = args.image_duration;
@@ -127,6 +148,7 @@ PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::
   // Off screen, play renders headless like convert, on the GPU --gpu picks.
   if (args.output != "offscreen") refuse_gpu_for_live_output(args.gpu, "play");
   CommonOptions common = parse_common_options(args, false);
+  audio_track_number(args.aid);  // a bad --aid is said before any input opens
   try {
     display_driver(args.output);
   } catch (const std::invalid_argument& e) {
@@ -203,6 +225,22 @@ void add_play_options(CLI::App& cmd, PlayArgs& args) {
                  "Diagnostics: write a CSV line per presented refresh (pts, clock, audio clock, counters)");
 }
 
+namespace {
+
+// A file's sound: play's own (a game's window has none to choose or set).
+void add_sound_options(CLI::App& cmd, PlayArgs& args) {
+  cmd.add_option("--aid", args.aid, "Audio track: its number (1 = the file's first audio stream), auto or no")
+      ->capture_default_str();
+  cmd.add_option("--alang", args.alang, "Audio track by language, first match wins: eng,ger (ISO 639-2 as tagged)")
+      ->delimiter(',');
+  cmd.add_option("--volume", args.volume, "Volume 0 to 130 (100: as decoded; keys 9 0 / *)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 130.0));
+  cmd.add_flag("--mute", args.mute, "Start muted (key m)");
+}
+
+}  // namespace
+
 void add_play_command(CLI::App& app) {
   auto args = std::make_shared<PlayArgs>();
   auto* cmd = app.add_subcommand("play",
@@ -217,6 +255,7 @@ void add_play_command(CLI::App& app) {
   cmd->add_option("--image-duration", args->image_duration,
                   "Show each photo this many seconds, then the next (default: until q or the next-file key)");
   cmd->add_flag("--no-resume", args->no_resume, "Start from the beginning, not where the file was stopped last time");
+  add_sound_options(*cmd, *args);
   cmd->callback([args] {
     args->resume = !args->no_resume;
     args->remember = true;

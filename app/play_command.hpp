@@ -17,6 +17,10 @@ struct PlayArgs : CommonArgs {
   std::string monitor;
   std::string connector;
   bool no_audio = false;
+  std::string aid = "auto";  // a track number, auto or no
+  std::vector<std::string> alang;
+  double volume = 100.0;
+  bool mute = false;
   bool quiet = false;
   std::string log_frames;
   // play's own (nelf run plays a live window: no playlist, no start, nothing remembered).

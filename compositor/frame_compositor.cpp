@@ -213,7 +213,7 @@ std::shared_ptr<const CompositeSetup> FrameCompositor::ahead_setup(const FrameOv
       calibration_grid(0);  // as prepare() would make it for the next frame (the optics may have changed)
       grid = grid_;
     }
-    message = message_cover(overlays.message);
+    message = message_cover(overlays.message, overlays.bar);
     defects = defect_plans({content_aspect(), content_aspect()}, true);
   } catch (const std::runtime_error&) {
     return nullptr;  // no grid for these optics, or no font, or no mapping: render() says so
@@ -231,15 +231,17 @@ std::shared_ptr<const CompositeSetup> FrameCompositor::ahead_setup(const FrameOv
 
 // The message as a cover for the views' bytes (what TextOverlay::apply() draws into the view
 // textures on the GL path), or null for none. Made when the text or the views change.
-std::shared_ptr<const Image> FrameCompositor::message_cover(const std::string& text) {
+std::shared_ptr<const Image> FrameCompositor::message_cover(const std::string& text, double bar) {
   if (text.empty()) return nullptr;
   const double aspect = views_.aspect > 0.0 ? views_.aspect : static_cast<double>(views_.width) / views_.height;
-  if (!message_ || message_text_ != text || message_->width() != texture_w() || message_->height() != texture_h() ||
-      message_aspect_ != aspect) {
+  if (!message_ || message_text_ != text || message_bar_ != bar || message_->width() != texture_w() ||
+      message_->height() != texture_h() || message_aspect_ != aspect) {
     TextOverlay& overlay = text_overlay();
     overlay.set_text(text);
+    overlay.set_bar(bar);
     message_ = std::make_shared<const Image>(overlay.cover(texture_w(), texture_h(), aspect));
     message_text_ = text;
+    message_bar_ = bar;
     message_aspect_ = aspect;
   }
   return message_;
@@ -247,11 +249,11 @@ std::shared_ptr<const Image> FrameCompositor::message_cover(const std::string& t
 
 // The views' bytes the tables composite: the frame's own, or the copies with the grid drawn over
 // them, and the message over those.
-std::array<const std::uint8_t*, 2> FrameCompositor::covered_views(const std::string& text) {
+std::array<const std::uint8_t*, 2> FrameCompositor::covered_views(const FrameOverlays& overlays) {
   std::array<const std::uint8_t*, 2> views =
       calibration_ ? std::array<const std::uint8_t*, 2>{grid_views_[0].data(), grid_views_[1].data()}
                    : std::array<const std::uint8_t*, 2>{frame_->left.data(), frame_->right.data()};
-  const auto message = message_cover(text);
+  const auto message = message_cover(overlays.message, overlays.bar);
   const std::size_t view_bytes = static_cast<std::size_t>(texture_w()) * texture_h() * 4;
   for (std::size_t i = 0; i < 2; ++i)
     views[i] = covered_view({views[i], view_bytes}, nullptr, message.get(), message_views_[i]);
@@ -322,7 +324,7 @@ bool FrameCompositor::render(const Frame& frame, const FrameOverlays& overlays, 
 // Both eyes into a CPU copy of the packed frame, then that into the target's texture: one upload
 // of the whole frame, since the eyes' panels are nearly all of it.
 void FrameCompositor::render_tables(const FrameOverlays& overlays, const GlPackedTarget& target) {
-  const auto views = covered_views(overlays.message);
+  const auto views = covered_views(overlays);
   render_packed_frame(tables_, views, static_cast<std::size_t>(texture_w()) * 4, overlays.swap_eyes, layout_.origins,
                       target.size, packed_);
   compensate_packed_eyes(defect_plans({content_aspect(), content_aspect()}, true), layout_.origins,
@@ -332,7 +334,7 @@ void FrameCompositor::render_tables(const FrameOverlays& overlays, const GlPacke
 
 // Both eyes from their tables straight into the packed frame's bytes (RGBA), black around them.
 void FrameCompositor::render_tables(const FrameOverlays& overlays, PackedFrame& out) {
-  auto views = covered_views(overlays.message);
+  auto views = covered_views(overlays);
   if (overlays.swap_eyes) std::swap(views[0], views[1]);
   out.bits = 8;
   out.rgba.resize(static_cast<std::size_t>(out.width) * out.height * 4);
@@ -386,7 +388,10 @@ void FrameCompositor::upload_views() {
 void FrameCompositor::render_gl(const FrameOverlays& overlays, unsigned int framebuffer) {
   upload_views();
   const bool message = !overlays.message.empty();
-  if (message || overlay_) text_overlay().set_text(overlays.message);
+  if (message || overlay_) {
+    text_overlay().set_text(overlays.message);
+    overlay_->set_bar(overlays.bar);
+  }
   for (Eye eye : {Eye::left, Eye::right}) {
     const auto& origin = layout_.origins[static_cast<int>(eye)];
     if (!origin) continue;

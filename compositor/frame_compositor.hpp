@@ -39,6 +39,7 @@ struct FrameOverlays {
   std::string message;            // on-screen text, "" for none
   bool calibration_grid = false;  // the grid pattern over both views (FrameCompositor::set_grid_pattern)
   bool swap_eyes = false;         // eye e shows view e ^ 1
+  double bar = -1.0;              // with the message: a seek bar filled to this fraction; negative: none
 };
 
 // The views a stream's frames have as the compositor takes them (StereoVideoFrame's width, height,
@@ -158,8 +159,8 @@ class FrameCompositor {
   bool use_tables();
   void forget_tables();
   std::shared_ptr<const CompositeSetup> ahead_setup(const FrameOverlays& overlays, std::array<int, 2> packed);
-  std::shared_ptr<const Image> message_cover(const std::string& text);
-  std::array<const std::uint8_t*, 2> covered_views(const std::string& message);
+  std::shared_ptr<const Image> message_cover(const std::string& text, double bar);
+  std::array<const std::uint8_t*, 2> covered_views(const FrameOverlays& overlays);
   void render_tables(const FrameOverlays& overlays, const GlPackedTarget& target);
   void render_tables(const FrameOverlays& overlays, PackedFrame& out);
   void fill_outside_eyes(std::uint8_t* rgba) const;
@@ -197,6 +198,7 @@ class FrameCompositor {
   // with it drawn over them.
   std::shared_ptr<const Image> message_;
   std::string message_text_;
+  double message_bar_ = -1.0;
   double message_aspect_ = 0.0;
   std::array<std::vector<std::uint8_t>, 2> message_views_;
   // The CPU path: the tables for the current views and optics (tried when first used).

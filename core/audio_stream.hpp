@@ -23,6 +23,16 @@ class AudioError : public std::runtime_error {
 struct AudioFormat {
   int sample_rate = 0;
   int channels = 0;
+  int track = 0;  // which of the input's audio tracks (AudioTrack::number); 0: the input's default
+};
+
+// One of an input's audio tracks, as a player lists them to choose from.
+struct AudioTrack {
+  int number = 0;           // 1 for the first audio stream in the file, 2 for the next … (mpv's --aid)
+  std::string language;     // ISO 639-2 as the file tags it ("eng", "ger"); "" when untagged
+  std::string codec;        // "aac", "ac3"
+  int channels = 0;         // the source's
+  bool is_default = false;  // the one FFmpeg picks when nobody chooses (the file's default)
 };
 
 class AudioStream {

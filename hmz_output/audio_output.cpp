@@ -74,11 +74,18 @@ void SystemClock::restart_at(double seconds) {
 
 // --- AudioOutput ------------------------------------------------------------------------------
 
-std::unique_ptr<AudioOutput> AudioOutput::open(int sample_rate, std::string& why_not) {
+void apply_volume(std::span<float> samples, double volume, bool muted) {
+  const double v = std::clamp(volume, 0.0, 130.0) / 100.0;
+  const auto gain = static_cast<float>(muted ? 0.0 : v * v * v);
+  if (gain == 1.f) return;
+  for (float& sample : samples) sample *= gain;
+}
+
+std::unique_ptr<AudioOutput> AudioOutput::open(int sample_rate, int channels, std::string& why_not) {
   SDL_AudioSpec want{};
   want.freq = sample_rate;
   want.format = AUDIO_F32SYS;
-  want.channels = 2;
+  want.channels = static_cast<Uint8>(std::clamp(channels, 1, 8));
   want.samples = 512;  // ~10 ms at 48 kHz: the granularity of the audio clock
   SDL_AudioSpec have{};
   SDL_AudioDeviceID device = 0;
@@ -88,7 +95,15 @@ std::unique_ptr<AudioOutput> AudioOutput::open(int sample_rate, std::string& why
       why_not = SDL_GetError();
       return nullptr;
     }
-    device = SDL_OpenAudioDevice(nullptr, 0, &want, &have, 0);
+    // Allowing a change of the channel count makes SDL say what the device really takes instead of
+    // mixing down itself; anything but what was asked for then gets stereo, which SDL converts to
+    // whatever the device has.
+    device = SDL_OpenAudioDevice(nullptr, 0, &want, &have, want.channels > 2 ? SDL_AUDIO_ALLOW_CHANNELS_CHANGE : 0);
+    if (device != 0 && have.channels != want.channels) {
+      SDL_CloseAudioDevice(device);
+      want.channels = 2;
+      device = SDL_OpenAudioDevice(nullptr, 0, &want, &have, 0);
+    }
   }
   if (device == 0) {
     why_not = SDL_GetError();
@@ -107,31 +122,43 @@ AudioOutput::~AudioOutput() {
 
 std::string AudioOutput::description() const {
   const char* driver = SDL_GetCurrentAudioDriver();
-  return fmt::format("{}, {} Hz, {}-sample buffer", driver ? driver : "?", spec_.freq, spec_.samples);
+  return fmt::format("{}, {} Hz, {} channels, {}-sample buffer", driver ? driver : "?", spec_.freq, spec_.channels,
+                     spec_.samples);
 }
 
 void AudioOutput::queue(const AudioChunk& chunk) {
-  if (chunk.channels != 2) throw std::logic_error("AudioOutput::queue: the device plays stereo chunks only");
+  const int channels = spec_.channels;
+  if (chunk.channels != channels)
+    throw std::logic_error(
+        fmt::format("AudioOutput::queue: a {}-channel chunk for a {}-channel device", chunk.channels, channels));
   if (chunk.samples.empty()) return;
   std::lock_guard lock(mutex_);
   if (queued_end_pts_) {
     const double gap = chunk.pts_s - *queued_end_pts_;
     if (gap > 1.0 / spec_.freq && gap < 10.0) {
-      const std::vector<float> silence(static_cast<std::size_t>(std::lround(gap * spec_.freq)) * 2, 0.f);
+      const std::vector<float> silence(static_cast<std::size_t>(std::lround(gap * spec_.freq)) * channels, 0.f);
       SDL_QueueAudio(device_, silence.data(), static_cast<Uint32>(silence.size() * sizeof(float)));
-      *queued_end_pts_ += static_cast<double>(silence.size() / 2) / spec_.freq;
+      *queued_end_pts_ += static_cast<double>(silence.size() / channels) / spec_.freq;
     }
   } else {
     queued_end_pts_ = chunk.pts_s;
   }
-  SDL_QueueAudio(device_, chunk.samples.data(), static_cast<Uint32>(chunk.samples.size() * sizeof(float)));
+  std::vector<float> scaled = chunk.samples;
+  apply_volume(scaled, volume_, muted_);
+  SDL_QueueAudio(device_, scaled.data(), static_cast<Uint32>(scaled.size() * sizeof(float)));
   *queued_end_pts_ += static_cast<double>(chunk.frames()) / spec_.freq;
   end_of_stream_ = false;
   drained_at_.reset();
 }
 
+void AudioOutput::set_volume(double volume, bool muted) {
+  std::lock_guard lock(mutex_);
+  volume_ = volume;
+  muted_ = muted;
+}
+
 double AudioOutput::buffered_s() const {
-  return static_cast<double>(SDL_GetQueuedAudioSize(device_)) / (spec_.freq * 2.0 * sizeof(float));
+  return static_cast<double>(SDL_GetQueuedAudioSize(device_)) / (spec_.freq * spec_.channels * sizeof(float));
 }
 
 void AudioOutput::end_of_stream() {
@@ -143,7 +170,7 @@ double AudioOutput::now_locked() const {
   const auto t = Steady::now();
   if (!queued_end_pts_) return hold_pts_;
   const Uint32 queued = SDL_GetQueuedAudioSize(device_);
-  const double bytes_per_s = spec_.freq * 2.0 * sizeof(float);
+  const double bytes_per_s = spec_.freq * static_cast<double>(spec_.channels) * sizeof(float);
   const double buffer_s = static_cast<double>(spec_.samples) / spec_.freq;
   if (queued == 0 && end_of_stream_) {
     // Audio is over; video may go on: continue from where the sound ended.

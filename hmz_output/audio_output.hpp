@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "core/frames.hpp"
@@ -48,24 +49,37 @@ class SystemClock final : public PlaybackClock {
   bool paused_ = false;
 };
 
-// An open SDL audio device playing interleaved float stereo. Starts paused until the first
-// set_paused(false).
+// Scales `samples` by the gain of `volume` (mpv's scale: 0 to 130, 100 = as decoded, cubic, so that
+// equal steps sound like equal steps), or silences them when `muted`.
+void apply_volume(std::span<float> samples, double volume, bool muted);
+
+// An open SDL audio device playing interleaved float samples (stereo, or up to 7.1 in SDL2's
+// channel order). Starts paused until the first set_paused(false).
 class AudioOutput final : public PlaybackClock {
  public:
-  // Opens the default output device (SDL_AUDIODRIVER picks the driver) at `sample_rate`, or says
-  // why not in `why_not` and returns null: no audio subsystem, no device.
-  static std::unique_ptr<AudioOutput> open(int sample_rate, std::string& why_not);
+  // Opens the default output device (SDL_AUDIODRIVER picks the driver) at `sample_rate` with
+  // `channels` (1 to 8) when the device takes that many, else stereo (channels() says which), or
+  // says why not in `why_not` and returns null: no audio subsystem, no device.
+  static std::unique_ptr<AudioOutput> open(int sample_rate, int channels, std::string& why_not);
+  static std::unique_ptr<AudioOutput> open(int sample_rate, std::string& why_not) {
+    return open(sample_rate, 2, why_not);
+  }
   ~AudioOutput() override;
   AudioOutput(const AudioOutput&) = delete;
   AudioOutput& operator=(const AudioOutput&) = delete;
 
   int sample_rate() const { return spec_.freq; }
-  // "pulseaudio, 48000 Hz, 512-sample buffer"
+  int channels() const { return spec_.channels; }
+  // "pulseaudio, 48000 Hz, 2 channels, 512-sample buffer"
   std::string description() const;
 
-  // Appends samples. A chunk starting later than the end of what was queued is preceded by silence
-  // (so that the clock stays on the pts timeline); one starting earlier is queued as it is.
+  // Appends samples (chunks of channels() channels), scaled by the volume. A chunk starting later
+  // than the end of what was queued is preceded by silence (so that the clock stays on the pts
+  // timeline); one starting earlier is queued as it is.
   void queue(const AudioChunk& chunk);
+  // The volume (0 to 130, see apply_volume) and mute of the chunks queued from now on: what is
+  // already queued (the feeder keeps about half a second) plays out at the old volume.
+  void set_volume(double volume, bool muted);
   // Seconds of sound queued and not yet heard.
   double buffered_s() const;
   // No more samples will come: once the queue runs dry the clock goes on with the system clock
@@ -89,6 +103,8 @@ class AudioOutput final : public PlaybackClock {
   double hold_pts_ = 0.0;                 // the clock before any sample was queued
   bool paused_ = true;
   bool end_of_stream_ = false;
+  double volume_ = 100.0;
+  bool muted_ = false;
   // Smoothing: the last computed clock, when it changed, and what the queue held then.
   mutable std::uint32_t last_queued_bytes_ = 0;
   mutable double last_clock_ = 0.0;

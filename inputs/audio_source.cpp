@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 extern "C" {
 #include <libavcodec/avcodec.h>
@@ -24,7 +25,50 @@ struct SwrContextDeleter {
 };
 using SwrContextPtr = std::unique_ptr<SwrContext, SwrContextDeleter>;
 
+[[noreturn]] void fail_on(const std::string& path, const std::string& why) {
+  throw AudioError(fmt::format("{}: {}", path, why));
+}
+
+// Opens `path` and reads its streams' parameters.
+void open_container(const std::string& path, bool allow_network, ffmpeg::InputGuard& network,
+                    ffmpeg::FormatContextPtr& format) {
+  // The same rule as VideoSource (DESIGN.md §11): no network unless asked for.
+  network.allow_network = allow_network;
+  const int opened = ffmpeg::open_input(format, path, network);
+  if (const auto stopped = ffmpeg::guard_stop(path, network)) throw AudioError(*stopped);
+  if (opened < 0) fail_on(path, fmt::format("cannot open: {}", ffmpeg::error_string(opened)));
+  const int found = ffmpeg::find_stream_info(format.get(), network);
+  if (const auto stopped = ffmpeg::guard_stop(path, network)) throw AudioError(*stopped);
+  if (found < 0) fail_on(path, fmt::format("not a readable media file: {}", ffmpeg::error_string(found)));
+}
+
+// The container indices of the audio streams, in the file's order: track N is the N-th.
+std::vector<int> audio_stream_indices(const AVFormatContext& format) {
+  std::vector<int> audio;
+  for (unsigned i = 0; i < format.nb_streams; ++i)
+    if (format.streams[i]->codecpar->codec_type == AVMEDIA_TYPE_AUDIO) audio.push_back(static_cast<int>(i));
+  return audio;
+}
+
 }  // namespace
+
+AVChannelLayout sdl_channel_layout(int channels) {
+  // SDL2's interleaved order for 1 to 8 channels (SDL_audio.h) is FFmpeg's native order of these
+  // channel masks, so the resampler writes each channel where SDL plays it.
+  static constexpr std::uint64_t masks[] = {
+      AV_CH_LAYOUT_MONO,
+      AV_CH_LAYOUT_STEREO,
+      AV_CH_LAYOUT_2POINT1,                      // FL FR LFE
+      AV_CH_LAYOUT_QUAD,                         // FL FR BL BR
+      AV_CH_LAYOUT_QUAD | AV_CH_LOW_FREQUENCY,   // FL FR LFE BL BR
+      AV_CH_LAYOUT_5POINT1,                      // FL FR FC LFE SL SR
+      AV_CH_LAYOUT_5POINT1 | AV_CH_BACK_CENTER,  // FL FR FC LFE BC SL SR
+      AV_CH_LAYOUT_7POINT1,                      // FL FR FC LFE BL BR SL SR
+  };
+  AVChannelLayout layout{};
+  av_channel_layout_from_mask(&layout, masks[std::clamp(channels, 1, 8) - 1]);
+  return layout;
+}
 
 struct AudioSource::Impl {
   std::string path;
@@ -48,18 +92,18 @@ struct AudioSource::Impl {
     path = p;
     options = o;
     if (options.sample_rate <= 0) fail("the audio sample rate must be > 0");
-    if (options.channels <= 0) fail("the audio channel count must be > 0");
-    // The same rule as VideoSource (DESIGN.md §11): no network unless asked for.
-    network.allow_network = options.allow_network;
-    const int opened = ffmpeg::open_input(format, path, network);
-    if (const auto stopped = ffmpeg::guard_stop(path, network)) throw AudioError(*stopped);
-    if (opened < 0) fail(fmt::format("cannot open: {}", ffmpeg::error_string(opened)));
-    const int found = ffmpeg::find_stream_info(format.get(), network);
-    if (const auto stopped = ffmpeg::guard_stop(path, network)) throw AudioError(*stopped);
-    if (found < 0) fail(fmt::format("not a readable media file: {}", ffmpeg::error_string(found)));
+    if (options.channels <= 0 || options.channels > 8) fail("the audio channel count must be 1 to 8");
+    open_container(path, options.allow_network, network, format);
     const AVCodec* decoder = nullptr;
-    const int best = av_find_best_stream(format.get(), AVMEDIA_TYPE_AUDIO, -1, -1, &decoder, 0);
+    int best = av_find_best_stream(format.get(), AVMEDIA_TYPE_AUDIO, -1, -1, &decoder, 0);
     if (best == AVERROR_STREAM_NOT_FOUND) fail("no audio stream");
+    if (options.track > 0) {
+      const std::vector<int> audio = audio_stream_indices(*format);
+      if (options.track > static_cast<int>(audio.size()))
+        fail(fmt::format("no audio track {} (the file has {})", options.track, audio.size()));
+      best = audio[static_cast<std::size_t>(options.track - 1)];
+      decoder = avcodec_find_decoder(format->streams[best]->codecpar->codec_id);
+    }
     if (best < 0 || !decoder) fail(fmt::format("no decoder for the audio stream: {}", ffmpeg::error_string(best)));
     stream = format->streams[best];
     for (unsigned i = 0; i < format->nb_streams; ++i)
@@ -80,8 +124,7 @@ struct AudioSource::Impl {
       av_channel_layout_default(&in_layout, std::max(1, f.ch_layout.nb_channels));
     else if (av_channel_layout_copy(&in_layout, &f.ch_layout) < 0)
       fail("cannot read the audio channel layout");
-    AVChannelLayout out_layout{};
-    av_channel_layout_default(&out_layout, options.channels);
+    AVChannelLayout out_layout = sdl_channel_layout(options.channels);
     SwrContext* raw = nullptr;
     const int r = swr_alloc_set_opts2(&raw, &out_layout, AV_SAMPLE_FMT_FLT, options.sample_rate, &in_layout,
                                       static_cast<AVSampleFormat>(f.format), f.sample_rate, 0, nullptr);
@@ -213,8 +256,33 @@ int AudioSource::channels() const { return impl_->options.channels; }
 std::string AudioSource::codec_name() const { return impl_->codec->codec->name; }
 std::int64_t AudioSource::decode_errors() const { return impl_->errors; }
 
+std::vector<AudioTrack> file_audio_tracks(const std::string& path, bool allow_network) {
+  ffmpeg::InputGuard network;
+  ffmpeg::FormatContextPtr format;
+  try {
+    open_container(path, allow_network, network, format);
+  } catch (const AudioError&) {
+    return {};
+  }
+  const int best = av_find_best_stream(format.get(), AVMEDIA_TYPE_AUDIO, -1, -1, nullptr, 0);
+  std::vector<AudioTrack> tracks;
+  for (const int index : audio_stream_indices(*format)) {
+    const AVStream& stream = *format->streams[index];
+    AudioTrack track;
+    track.number = static_cast<int>(tracks.size()) + 1;
+    if (const AVDictionaryEntry* language = av_dict_get(stream.metadata, "language", nullptr, 0))
+      track.language = language->value;
+    track.codec = avcodec_get_name(stream.codecpar->codec_id);
+    track.channels = stream.codecpar->ch_layout.nb_channels;
+    track.is_default = index == best;
+    tracks.push_back(std::move(track));
+  }
+  return tracks;
+}
+
 OpenedAudio open_file_audio(const std::string& path, double origin_s, bool allow_network, AudioFormat format) {
   AudioSourceOptions options;
+  options.track = format.track;
   options.origin_s = origin_s;
   options.allow_network = allow_network;
   if (format.sample_rate > 0) options.sample_rate = format.sample_rate;

@@ -1,6 +1,6 @@
 #pragma once
 // A media file's audio as an AudioStream: the default audio stream, decoded with libavcodec and
-// resampled with libswresample to interleaved float (stereo unless asked otherwise) at the
+// (or the track asked for) resampled with libswresample to interleaved float (stereo unless asked otherwise) at the
 // output's rate, each chunk stamped with its presentation time on the video's timeline (seconds
 // from the same origin as StereoVideoFrame::pts_s). Damaged packets are skipped and counted, as
 // for video.
@@ -13,13 +13,18 @@
 #include "core/audio_stream.hpp"
 #include "core/frames.hpp"
 
+extern "C" {
+#include <libavutil/channel_layout.h>
+}
+
 namespace nelf {
 
 struct AudioSourceOptions {
   int sample_rate = 48000;     // of the delivered samples
   double origin_s = 0.0;       // container time that becomes pts 0 (the video's origin)
   bool allow_network = false;  // false: FFmpeg may only use the file and pipe protocols
-  int channels = 2;            // of the delivered samples
+  int channels = 2;            // of the delivered samples (1 to 8, in SDL2's channel order)
+  int track = 0;               // the N-th audio stream of the file (AudioTrack::number); 0: FFmpeg's best
 };
 
 class AudioSource final : public AudioStream {
@@ -48,6 +53,13 @@ class AudioSource final : public AudioStream {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The channel layout of `channels` (1 to 8) interleaved in the order SDL2 plays them: stereo,
+// 5.1 (FL FR FC LFE SL SR), 7.1 (FL FR FC LFE BL BR SL SR) … what the samples are converted to.
+AVChannelLayout sdl_channel_layout(int channels);
+
+// The audio tracks of the media file `path` (empty when it has none or cannot be opened).
+std::vector<AudioTrack> file_audio_tracks(const std::string& path, bool allow_network);
 
 // The audio of the media file `path` as `format` asks (0: 48000 Hz, stereo), with container time
 // `origin_s` (the video's first frame) as pts 0; or, when the file has no audio or it cannot be

@@ -22,6 +22,7 @@ class EstimatedDepthSource final : public Source {
   }
   ViewFormat negotiate(const ViewFormat& wanted) override { return source_->negotiate(wanted); }
   OpenedAudio open_audio(AudioFormat format) const override { return source_->open_audio(format); }
+  std::vector<AudioTrack> audio_tracks() const override { return source_->audio_tracks(); }
   std::unique_ptr<CarriedStreams> open_carried_streams() const override { return source_->open_carried_streams(); }
   std::int64_t lost_frames() const override { return source_->lost_frames(); }
 

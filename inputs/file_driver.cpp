@@ -147,6 +147,10 @@ class FileFrameSource final : public Source {
     if (!device_.empty()) return {nullptr, "a capture device's sound is not read"};
     return open_file_audio(path_, origin_s_, allow_network_, format);
   }
+  std::vector<AudioTrack> audio_tracks() const override {
+    if (!device_.empty()) return {};
+    return file_audio_tracks(path_, allow_network_);
+  }
   std::unique_ptr<CarriedStreams> open_carried_streams() const override {
     if (!device_.empty()) return nullptr;
     return open_file_carried_streams(path_, origin_s_, allow_network_);

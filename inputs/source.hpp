@@ -75,6 +75,9 @@ class Source {
   // start or the requested start): a file's audio, the synthetic clip's tone; or why there is none,
   // in words ("no audio stream", "the audio cannot be decoded (…)"). Each call opens a new stream.
   virtual OpenedAudio open_audio(AudioFormat /*format*/) const { return {nullptr, "no audio stream"}; }
+  // The input's audio tracks that open_audio() can choose among (AudioFormat::track), in the
+  // file's order; empty when it has none or only one made-up sound (the synthetic clip's tone).
+  virtual std::vector<AudioTrack> audio_tracks() const { return {}; }
   // The encoded streams a file output copies as they are (a file's audio, subtitles, chapters and
   // metadata), on the pts_s timeline; null when the input has none to copy (the synthetic clip:
   // its sound is open_audio()'s to encode). Throws UserError when they cannot be opened.

@@ -33,6 +33,12 @@ enum class Command {
   fullscreen,
   next_file,
   previous_file,
+  next_audio_track,
+  volume_down,
+  volume_up,
+  mute,
+  show_progress,
+  keep_progress,
   // calibrate
   next_eye,
   shift_left,

@@ -25,10 +25,46 @@ void PlayCommands::say(std::string text) {
   message_until_ = std::chrono::steady_clock::now() + std::chrono::seconds(2);
 }
 
+std::string clock_time(double seconds) {
+  const auto s = static_cast<long>(std::floor(std::max(0.0, seconds)));
+  return fmt::format("{}:{:02d}:{:02d}", s / 3600, s / 60 % 60, s % 60);
+}
+
 void PlayCommands::expire_message() {
-  if (message_.empty() || std::chrono::steady_clock::now() <= message_until_) return;
-  message_.clear();
+  const auto now = std::chrono::steady_clock::now();
+  if (!message_.empty() && now > message_until_) {
+    message_.clear();
+    state_.dirty = true;
+  }
+  if (progress_until_ && now > *progress_until_) {
+    progress_until_.reset();
+    state_.dirty = true;
+  }
+}
+
+void PlayCommands::show_progress() {
   state_.dirty = true;
+  if (options_.on_screen_messages) progress_until_ = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+}
+
+double PlayCommands::position() const {
+  if (state_.awaiting_seek) return state_.seek_target_s;
+  return state_.current ? state_.current->pts_s : sound_.clock().now();
+}
+
+FrameOverlays PlayCommands::overlays() const {
+  FrameOverlays o{message_, state_.calibration, state_.swap_eyes};
+  if (!progress_until_ && !keep_progress_) return o;
+  // Whole seconds, as the time line says: the bar then moves when the text changes, not with every
+  // frame (each change draws the label again).
+  const double at = std::floor(std::max(0.0, position()));
+  if (duration_s_ && *duration_s_ > 0) {
+    o.bar = std::clamp(at / *duration_s_, 0.0, 1.0);
+    if (o.message.empty()) o.message = fmt::format("{} / {}", clock_time(at), clock_time(*duration_s_));
+  } else if (o.message.empty()) {
+    o.message = clock_time(at);
+  }
+  return o;
 }
 
 void PlayCommands::seek_to(double seconds, const std::string& what) {
@@ -49,8 +85,10 @@ void PlayCommands::seek_by(double delta) {
   const double from = state_.current ? state_.current->pts_s : sound_.clock().now();
   double target = std::max(0.0, from + delta);
   if (duration_s_) target = std::min(target, std::max(0.0, *duration_s_ - 0.001));
-  seek_to(target, fmt::format("{} {:.0f} s: {}:{:02d}", delta < 0 ? "back" : "forward", std::abs(delta),
-                              static_cast<int>(target) / 60, static_cast<int>(target) % 60));
+  seek_to(target, "");
+  // mpv's OSD after a seek: where it is now, on the time line and the bar.
+  message_.clear();
+  show_progress();
 }
 
 std::optional<PlayEnd> PlayCommands::other_file(bool next) {
@@ -134,6 +172,31 @@ std::optional<PlayEnd> PlayCommands::apply(Command command) {
       say(display_.toggle_fullscreen());
       state_.dirty = true;
       break;
+    case Command::show_progress:
+      show_progress();
+      break;
+    case Command::keep_progress:
+      keep_progress_ = !keep_progress_;
+      progress_until_.reset();
+      state_.dirty = true;
+      break;
+    case Command::volume_down:
+    case Command::volume_up:
+      say(sound_.change_volume(command == Command::volume_up ? 2.0 : -2.0));
+      break;
+    case Command::mute:
+      say(sound_.toggle_mute());
+      break;
+    case Command::next_audio_track: {
+      bool changed = false;
+      const std::string what = sound_.next_track(changed);
+      // The new track starts where the picture is: a seek there puts the clock, the sound and the
+      // frames back in step.
+      if (changed) seek_to(position(), "");
+      if (!options_.quiet) fmt::print(stderr, "nelf: {}\n", what);  // as the status line named the first
+      say(what);
+      break;
+    }
     case Command::help: {
       // Each press shows the next line on screen; the first also prints them all.
       const std::vector<std::string> lines = key_help(KeyScope::play);

@@ -1,7 +1,8 @@
 #pragma once
 // What the keys do during `nelf play` (player/key_bindings.cpp maps keys to these commands): pause,
-// seek, the screen's distance and the IPD, swapping the eyes, the calibration grid, fullscreen and
-// the key help, each with its on-screen message. The play loop reads the state they leave.
+// seek (with the time line and seek bar), the screen's distance and the IPD, swapping the eyes, the
+// calibration grid, fullscreen, volume, mute, the audio track and the key help, each with its
+// on-screen message. The play loop reads the state they leave.
 #include <chrono>
 #include <cstddef>
 #include <memory>
@@ -61,12 +62,17 @@ class PlayCommands {
   void say(std::string text);
   // Takes the message off the screen once its two seconds are up.
   void expire_message();
-  // What the state asks to be drawn over the frame: the message, the grid, the eyes swapped.
-  FrameOverlays overlays() const { return {message_, state_.calibration, state_.swap_eyes}; }
+  // What the state asks to be drawn over the frame: the message (or the time line) with the seek
+  // bar while it shows, the grid, the eyes swapped.
+  FrameOverlays overlays() const;
 
  private:
   void seek_by(double delta_s);
   std::optional<PlayEnd> other_file(bool next);
+  // The time line and the seek bar for two seconds (after a seek, key o).
+  void show_progress();
+  // Where playback is: the frame on screen, or where a seek goes.
+  double position() const;
   void change_profile(const Profile& changed, const std::string& what);
 
   PlayState& state_;
@@ -82,6 +88,11 @@ class PlayCommands {
   std::size_t help_line_ = 0;  // the next line of the key help that h shows
   std::string message_;
   std::chrono::steady_clock::time_point message_until_{};
+  std::optional<std::chrono::steady_clock::time_point> progress_until_;
+  bool keep_progress_ = false;  // key O
 };
+
+// "1:02:03": hours, minutes and seconds (whole seconds, rounded down), as the time line shows them.
+std::string clock_time(double seconds);
 
 }  // namespace nelf::playback

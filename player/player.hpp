@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "compositor/compositor.hpp"
 #include "hmz_output/display.hpp"
@@ -27,8 +28,13 @@ struct PlayerOptions {
   Profile profile;
   Signal signal;
   CompositorOptions compositor;
-  bool audio = true;  // false: --no-audio
+  bool audio = true;                           // false: --no-audio
+  std::string no_audio_reason = "--no-audio";  // what the status line says when audio is false
   int audio_rate = 48000;
+  std::optional<int> audio_track;            // --aid N: the file's N-th audio track
+  std::vector<std::string> audio_languages;  // --alang: the first track in the first of these
+  double volume = 100.0;                     // --volume, 0 to 130 (100: as decoded)
+  bool mute = false;
   std::string log_frames;  // CSV of every refresh (diagnostics); "" = none
   bool quiet = false;      // no "playing …" / audio status lines on stderr (warnings still are)
   // Each key's change said on screen for 2 s. Off (tests): while a message shows, frames are

@@ -24,6 +24,8 @@ constexpr int kMinimumFontPx = 8;
 constexpr double kMaximumWidthFraction = 0.9;  // of the view's width
 constexpr double kBoxCentreFromTop = 0.75;     // lower third
 constexpr float kBoxOpacity = 0.6f;
+constexpr int kBarLengthInFonts = 12;
+constexpr float kBarRestGrey = 0.35f;
 
 // Formats the output can keep; anything else (sRGB, RGB without alpha, integer) becomes RGBA16F.
 GLenum output_format(GLenum view_format) {
@@ -57,9 +59,10 @@ TextOverlay::TextOverlay()
 TextOverlay::~TextOverlay() = default;
 
 void TextOverlay::set_text(std::string text) { text_ = std::move(text); }
+void TextOverlay::set_bar(double fraction) { bar_ = fraction < 0.0 ? -1.0 : std::min(fraction, 1.0); }
 
 const TextOverlay::Label& TextOverlay::cpu_label(int font_px) {
-  if (!label_.rgba.empty() && label_.text == text_ && label_.font_px == font_px) return label_;
+  if (!label_.rgba.empty() && label_.text == text_ && label_.bar == bar_ && label_.font_px == font_px) return label_;
   const std::string font = chart::font();
   const auto extent = image_library::text_size(text_, font_px, font);
   if (!extent)
@@ -69,7 +72,15 @@ const TextOverlay::Label& TextOverlay::cpu_label(int font_px) {
   const int pad = std::max(2, font_px / 3);
   const int ascent = std::max(static_cast<int>(std::lround(0.95 * font_px)), -extent->y_begin);
   const int descent = std::max(static_cast<int>(std::lround(0.25 * font_px)), extent->y_end);
-  const int width = extent->width() + 2 * pad, height = ascent + descent + 2 * pad;
+  // The seek bar: a line under the text, long enough to point at a place (12 font sizes), as thick as
+  // a stroke of a capital letter is tall at a third of it, so that it survives the scaling down into
+  // a preview window as the text does.
+  const bool bar = bar_ >= 0.0;
+  const int bar_width = bar ? kBarLengthInFonts * font_px : 0;
+  const int bar_height = bar ? std::max(3, font_px / 3) : 0;
+  const int text_height = ascent + descent;
+  const int width = std::max(extent->width(), bar_width) + 2 * pad;
+  const int height = text_height + 2 * pad + (bar ? bar_height + pad : 0);
 
   // White text on a translucent black box, drawn as float and stored as RGBA8.
   std::vector<float> image(static_cast<std::size_t>(width) * height * 4);
@@ -77,15 +88,29 @@ const TextOverlay::Label& TextOverlay::cpu_label(int font_px) {
   const float white[4] = {1.f, 1.f, 1.f, 1.f};
   try {
     image_library::render_text({.values = image.data(), .width = width, .height = height, .channels = 4},
-                               pad - extent->x_begin, pad + ascent, text_, font_px, font, white);
+                               (width - extent->width()) / 2 - extent->x_begin, pad + ascent, text_, font_px, font,
+                               white);
   } catch (const image_library::ImageLibraryError& e) {
     throw std::runtime_error(fmt::format("cannot render the on-screen text: {}", e.what()));
+  }
+  if (bar) {
+    // Played: white; still to come: grey; both opaque so that the place reads against any picture.
+    const int x0 = (width - bar_width) / 2, y0 = pad + text_height + pad / 2;
+    const int filled = static_cast<int>(std::lround(bar_ * bar_width));
+    for (int y = y0; y < y0 + bar_height && y < height; ++y)
+      for (int x = x0; x < x0 + bar_width; ++x) {
+        float* p = &image[(static_cast<std::size_t>(y) * width + x) * 4];
+        const float v = x - x0 < filled ? 1.f : kBarRestGrey;
+        p[0] = p[1] = p[2] = v;
+        p[3] = 1.f;
+      }
   }
   label_.rgba.resize(image.size());
   for (std::size_t i = 0; i < image.size(); ++i)
     label_.rgba[i] = static_cast<std::uint8_t>(std::lround(std::clamp(image[i], 0.f, 1.f) * 255.f));
   label_.texture.reset();  // for the old text
   label_.text = text_;
+  label_.bar = bar_;
   label_.font_px = font_px;
   label_.width = width;
   label_.height = height;

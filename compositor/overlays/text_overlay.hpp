@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "compositor/compositor.hpp"
-#include "core/gl/objects.hpp"
 #include "compositor/gl/gl_compositor.hpp"
+#include "core/gl/objects.hpp"
 #include "core/image.hpp"
 
 namespace nelf {
@@ -33,6 +33,10 @@ class TextOverlay {
   // nothing. The text is rasterised again only when it or the size it is drawn at changes.
   void set_text(std::string text);
   const std::string& text() const { return text_; }
+  // A seek bar under the text, filled to `fraction` (0 to 1) of its length; negative: none. It is
+  // drawn into the same label as the text (so the CPU path's cover has it too).
+  void set_bar(double fraction);
+  double bar() const { return bar_; }
 
   // `view` with the text in a box: light on a translucent dark box, centred horizontally in the lower
   // third, its cap height 1/20 of the view's height (so it looks the same size at any source
@@ -57,6 +61,7 @@ class TextOverlay {
  private:
   struct Label {
     std::string text;
+    double bar = -1.0;
     int font_px = 0;
     int width = 0, height = 0;
     std::vector<std::uint8_t> rgba;  // as in `texture` (RGBA8, row 0 the top row)
@@ -82,6 +87,7 @@ class TextOverlay {
   const Label& label(int font_px);
 
   std::string text_;
+  double bar_ = -1.0;
   Label label_;
   std::array<EyeTarget, 2> eyes_;
   gl::Program program_;

@@ -28,4 +28,16 @@ inline std::string two_colour_input(int eye_width, int eye_height, bool stacked,
          std::to_string(frames);
 }
 
+// A side-by-side video (320x180 views, 24 fps) with two audio tracks, as a film with a dubbing
+// has them: track 1 stereo AAC tagged "eng" (440 Hz in both channels), track 2 5.1 AC-3 tagged
+// "ger" with a 1 kHz tone in the centre channel only, the others silent. `seconds` long.
+inline std::filesystem::path make_two_track_clip(const std::filesystem::path& output, int seconds = 2) {
+  const std::string d = ":d=" + std::to_string(seconds);
+  return make_media(output, "-f lavfi -i color=c=0xC03020:s=640x180:r=24" + d + " -f lavfi -i sine=f=440:r=48000" + d +
+                                " -f lavfi -i sine=f=1000:r=48000" + d +
+                                " -filter_complex \"[2]pan=5.1|FC=c0[surround]\" -map 0:v -map 1:a -map \"[surround]\""
+                                " -c:v libx264 -preset ultrafast -pix_fmt yuv420p -c:a:0 aac -ac:a:0 2 -c:a:1 ac3"
+                                " -metadata:s:a:0 language=eng -metadata:s:a:1 language=ger");
+}
+
 }  // namespace nelf::test

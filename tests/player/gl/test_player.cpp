@@ -443,6 +443,51 @@ TEST_F(PlayerTest, NoFrameCompositedAheadShowsAStateAKeyHasChanged) {
 // rate alone: a 24 fps clip on the 60 Hz signal shows every frame, none repeated or dropped, each
 // at the refresh FrameScheduler chooses for it (the 2, 3, 2, 3 … cadence), and the frame log says
 // so row by row, its clock one refresh period further each refresh.
+// O keeps the time line and seek bar on: the same clip on the stepped clock with and without it
+// differs, in both eyes' panels, at every frame from half a second on.
+TEST_F(PlayerTest, KeyOShowsTheTimeLineAndSeekBarInBothEyes) {
+  const auto clip = make_clip(dir_, 2);
+  PlayerOptions options = silent_options();
+  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
+  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
+  std::map<double, std::array<Image, 2>> shown[2];  // [0]: no key, [1]: O typed at the first frame
+  for (int run : {0, 1}) {
+    options.clock = std::make_shared<playback::SteppedClock>();
+    TypedKeysDisplay display(open_display(options));
+    bool typed = false;
+    options.after_render = [&](const Display& d, double pts) {
+      const auto panel = [&](const EyeArea& a) {
+        return read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90);
+      };
+      shown[run][pts] = {panel(left), panel(right)};
+      if (run == 1 && !typed) {
+        display.type(KeyPress::of(U'O'));
+        typed = true;
+      }
+    };
+    auto source = test::open_input(clip);
+    EXPECT_EQ(play(display, *source, options).end, PlayEnd::end_of_file);
+  }
+  int compared = 0;
+  for (const auto& [pts, eyes] : shown[1]) {
+    if (pts < 0.5 || !shown[0].count(pts)) continue;
+    for (int e : {0, 1}) {
+      const Image& with = eyes[static_cast<std::size_t>(e)];
+      const Image& without = shown[0][pts][static_cast<std::size_t>(e)];
+      int changed = 0;
+      for (int y = 0; y < 90; ++y)
+        for (int x = 0; x < 160; ++x) {
+          const float* a = &with.data()[(static_cast<std::size_t>(y) * 160 + x) * 4];
+          const float* b = &without.data()[(static_cast<std::size_t>(y) * 160 + x) * 4];
+          if (std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]) > 0.3f) ++changed;
+        }
+      EXPECT_GT(changed, 100) << "no time line at " << pts << " s in eye " << e;
+    }
+    ++compared;
+  }
+  EXPECT_GE(compared, 30);
+}
+
 TEST_F(PlayerTest, OnASteppedClockEachFrameIsShownAtTheRefreshTheSchedulerChooses) {
   const auto clip = test::make_media(dir_ / "24fps.mp4", test::two_colour_input(320, 180, false, 48, 24) +
                                                              " -c:v libx264 -preset ultrafast -pix_fmt yuv420p");
