@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "app/commands.hpp"
 #include "app/play_command.hpp"
@@ -20,6 +21,15 @@
 #include "player/player.hpp"
 
 namespace nelf::app {
+
+namespace {
+KeyRebindings& rebound_keys() {
+  static KeyRebindings keys;
+  return keys;
+}
+}  // namespace
+
+void use_key_rebindings(KeyRebindings rebindings) { rebound_keys() = std::move(rebindings); }
 
 PlayEnd play_input(const PlayArgs& args, SourceRequest request) {
   quiet_ffmpeg_logs(true);
@@ -54,6 +64,9 @@ PlayEnd play_input(const PlayArgs& args, SourceRequest request) {
   options.audio = !args.no_audio;
   options.log_frames = args.log_frames;
   options.quiet = args.quiet;
+  options.key_rebindings = rebound_keys();
+  options.ipc_server = args.input_ipc_server;
+  options.media_path = request.input;
 
   const auto display =
       open_live_display({args.output, args.monitor, args.connector, fmt::format("nelf: {}", request.input), args.gpu},
@@ -76,6 +89,8 @@ void add_play_options(CLI::App& cmd, PlayArgs& args) {
   cmd.add_flag("--quiet", args.quiet, "Only warnings and the summary line at exit");
   cmd.add_option("--log-frames", args.log_frames,
                  "Diagnostics: write a CSV line per presented refresh (pts, clock, audio clock, counters)");
+  cmd.add_option("--input-ipc-server", args.input_ipc_server,
+                 "Remote control: mpv's JSON IPC on this Unix socket (owner-only; removed at exit)");
 }
 
 void add_play_command(CLI::App& app) {

@@ -17,6 +17,7 @@ struct PlayArgs : CommonArgs {
   bool no_audio = false;
   bool quiet = false;
   std::string log_frames;
+  std::string input_ipc_server;
 };
 
 // The CommonArgs options (without INPUT) and play's own, on `cmd`.
@@ -26,5 +27,9 @@ void add_play_options(CLI::App& cmd, PlayArgs& args);
 // `args` names until it ends, the user quits or Ctrl-C; prints the summary line. Throws UserError
 // (status 130 when interrupted) as play reports it.
 PlayEnd play_input(const PlayArgs& args, SourceRequest request);
+
+// The keys play_input() plays with, rebound (the configuration file's [keys]; main() reads it
+// before the command line, so that play and run get the same keys).
+void use_key_rebindings(KeyRebindings rebindings);
 
 }  // namespace nelf::app

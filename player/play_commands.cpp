@@ -32,18 +32,24 @@ void PlayCommands::expire_message() {
 }
 
 void PlayCommands::seek_by(double delta) {
+  const double from = state_.current ? state_.current->pts_s : sound_.clock().now();
+  seek(from + delta, fmt::format("{} {:.0f} s", delta < 0 ? "back" : "forward", std::abs(delta)));
+}
+
+void PlayCommands::seek_to(double target) { seek(target, "to"); }
+
+void PlayCommands::seek(double target, const std::string& what) {
   PlaybackClock& clock = sound_.clock();
-  const double from = state_.current ? state_.current->pts_s : clock.now();
-  double target = std::max(0.0, from + delta);
+  target = std::max(0.0, target);
   if (duration_s_) target = std::min(target, std::max(0.0, *duration_s_ - 0.001));
   queue_.seek(target);
   sound_.seek(target);
   clock.restart_at(target);
   clock.set_paused(true);  // until the first frame after the seek is decoded
   state_.awaiting_seek = true;
+  state_.seek_target_s = target;
   scheduler_.reset();
-  say(fmt::format("{} {:.0f} s: {}:{:02d}", delta < 0 ? "back" : "forward", std::abs(delta),
-                  static_cast<int>(target) / 60, static_cast<int>(target) % 60));
+  say(fmt::format("{}: {}:{:02d}", what, static_cast<int>(target) / 60, static_cast<int>(target) % 60));
 }
 
 void PlayCommands::change_profile(const Profile& changed, const std::string& what) {
@@ -117,7 +123,7 @@ bool PlayCommands::apply(Command command) {
       break;
     case Command::help: {
       // Each press shows the next line on screen; the first also prints them all.
-      const std::vector<std::string> lines = key_help(KeyScope::play);
+      const std::vector<std::string> lines = key_help(KeyScope::play, options_.key_rebindings);
       if (help_line_ == 0 && !options_.quiet)
         for (const std::string& line : lines) fmt::print(stderr, "nelf: key {}\n", line);
       say(lines[help_line_++ % lines.size()]);

@@ -31,6 +31,7 @@ struct PlayState {
   bool swap_eyes = false;
   bool dirty = false;              // the packed frame must be rendered again
   bool awaiting_seek = false;      // the clock waits, paused, for the first frame after a seek
+  double seek_target_s = 0;        // where the last seek went (the position until its frame shows)
   bool show_while_paused = false;  // a seek while paused shows the first frame at the new place
   std::shared_ptr<const StereoVideoFrame> current;
 };
@@ -52,6 +53,9 @@ class PlayCommands {
 
   // Carries out `command`; false for quit.
   bool apply(Command command);
+  // Seeks `delta_s` from the frame on screen, or to `target_s` (within the file), as the arrows do.
+  void seek_by(double delta_s);
+  void seek_to(double target_s);
   // A message on screen for two seconds (when on-screen messages are on); the frame is redrawn.
   void say(std::string text);
   // Takes the message off the screen once its two seconds are up.
@@ -60,7 +64,7 @@ class PlayCommands {
   FrameOverlays overlays() const { return {message_, state_.calibration, state_.swap_eyes}; }
 
  private:
-  void seek_by(double delta_s);
+  void seek(double target_s, const std::string& what);
   void change_profile(const Profile& changed, const std::string& what);
 
   PlayState& state_;

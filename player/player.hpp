@@ -18,6 +18,7 @@
 #include "inputs/source.hpp"
 #include "optics/profile.hpp"
 #include "player/frame_scheduler.hpp"
+#include "player/key_bindings.hpp"
 #include "player/stepped_clock.hpp"
 
 namespace nelf {
@@ -28,8 +29,11 @@ struct PlayerOptions {
   CompositorOptions compositor;
   bool audio = true;  // false: --no-audio
   int audio_rate = 48000;
-  std::string log_frames;  // CSV of every refresh (diagnostics); "" = none
-  bool quiet = false;      // no "playing …" / audio status lines on stderr (warnings still are)
+  std::string log_frames;        // CSV of every refresh (diagnostics); "" = none
+  bool quiet = false;            // no "playing …" / audio status lines on stderr (warnings still are)
+  KeyRebindings key_rebindings;  // the configuration file's [keys]
+  std::string ipc_server;        // --input-ipc-server: mpv's JSON IPC on this socket; "" = none
+  std::string media_path;        // the input as given (the IPC's path and filename properties)
   // Each key's change said on screen for 2 s. Off (tests): while a message shows, frames are
   // composited with GL (the text is drawn there), so without them the CPU path and its frames
   // composited ahead are seen right after a key.
