@@ -7,6 +7,7 @@
 #include <string>
 
 #include "app/commands.hpp"
+#include "app/config_file.hpp"
 
 namespace nelf::app {
 
@@ -40,6 +41,7 @@ void build_cli(CLI::App& app) {
   app.set_version_flag("--version", fmt::format("nelf {}", NELF_VERSION));
   app.require_subcommand(1);
   for (auto add : registrars) add(app);
+  add_no_config_flag(app);
   refuse_non_finite_numbers(app);
 }
 

@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "app/commands.hpp"
 #include "app/play_command.hpp"
@@ -32,6 +33,10 @@
 namespace nelf::app {
 
 namespace {
+KeyRebindings& rebound_keys() {
+  static KeyRebindings keys;
+  return keys;
+}
 
 // --aid: N (the N-th audio track), auto (the file's default, or --alang's) or no (no sound).
 std::optional<int> audio_track_number(const std::string& aid) {
@@ -89,6 +94,9 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
   if (options.audio) playback::choose_audio_track(source->audio_tracks(), options.audio_track, options.audio_languages);
   options.log_frames = args.log_frames;
   options.quiet = args.quiet;
+  options.key_rebindings = rebound_keys();
+  options.ipc_server = args.input_ipc_server;
+  options.media_path = request.input;
   options.image_duration_s = args.image_duration;
   options.has_previous = index > 0;
   options.has_next = index + 1 < count;
@@ -137,6 +145,8 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
 }
 
 }  // namespace
+
+void use_key_rebindings(KeyRebindings rebindings) { rebound_keys() = std::move(rebindings); }
 
 PlayEnd play_input(const PlayArgs& args, SourceRequest request) {
   const std::string input = request.input;
@@ -223,6 +233,8 @@ void add_play_options(CLI::App& cmd, PlayArgs& args) {
   cmd.add_flag("--quiet", args.quiet, "Only warnings and the summary line at exit");
   cmd.add_option("--log-frames", args.log_frames,
                  "Diagnostics: write a CSV line per presented refresh (pts, clock, audio clock, counters)");
+  cmd.add_option("--input-ipc-server", args.input_ipc_server,
+                 "Remote control: mpv's JSON IPC on this Unix socket (owner-only; removed at exit)");
 }
 
 namespace {

@@ -9,8 +9,10 @@
 
 #include "app/cli_suggestions.hpp"
 #include "app/commands.hpp"
-#include "optics/profile.hpp"
+#include "app/config_file.hpp"
+#include "app/play_command.hpp"
 #include "core/printable.hpp"
+#include "optics/profile.hpp"
 
 namespace {
 
@@ -43,6 +45,9 @@ int main(int argc, char** argv) {
   nelf::app::build_cli(app);
 
   try {
+    if (!nelf::app::no_config_requested(argc, argv))
+      if (const auto config = nelf::app::config_file_path())
+        nelf::app::use_key_rebindings(nelf::app::apply_config_file(app, *config));
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);

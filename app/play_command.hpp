@@ -30,6 +30,7 @@ struct PlayArgs : CommonArgs {
   bool no_resume = false;                // --no-resume
   bool resume = false;                   // play: on unless --no-resume
   bool remember = false;                 // play: keep each file's position and set-up between runs
+  std::string input_ipc_server;
 };
 
 // The CommonArgs options (without INPUT) and play's own, on `cmd`.
@@ -43,5 +44,9 @@ PlayEnd play_input(const PlayArgs& args, SourceRequest request);
 // The same for each input of `inputs` in turn on one display, as a playlist: the keys step to the
 // next and previous one; an entry that fails is skipped with one line when there are others.
 PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& request, const std::vector<std::string>& inputs);
+
+// The keys play_input() plays with, rebound (the configuration file's [keys]; main() reads it
+// before the command line, so that play and run get the same keys).
+void use_key_rebindings(KeyRebindings rebindings);
 
 }  // namespace nelf::app

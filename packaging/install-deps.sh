@@ -24,6 +24,8 @@ packages=(
   libglm-dev libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libsdl2-dev libass-dev
   # tests (zsh and fish: the completion checks run them)
   libgtest-dev libgmock-dev zsh fish
+  # a real client of the JSON IPC socket (--input-ipc-server) for its tests, as mpv's scripts use
+  socat
   # the package checks (tests/package): the man page rendered as lintian does, lintian itself,
   # AppStream validation and the MIME database
   man-db lintian appstream shared-mime-info

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <initializer_list>
+
 namespace nelf {
 namespace {
 
@@ -240,22 +243,218 @@ const std::vector<KeyBinding>& key_bindings() {
   return table;
 }
 
-std::optional<Command> command_for(KeyScope scope, const KeyPress& key) {
+namespace {
+
+bool matches(const KeyPress& press, const KeyPress& key) {
+  return press.named != N::none ? key.is(press.named) : (!key.ctrl && !key.alt && key.is(press.character));
+}
+
+const KeyRebinding* rebinding_of(const KeyPress& press, const KeyRebindings& rebindings) {
+  for (const KeyRebinding& r : rebindings)
+    if (r.key.named == press.named && r.key.character == press.character) return &r;
+  return nullptr;
+}
+
+struct NamedCommand {
+  Command command;
+  std::string_view name;
+};
+// Play's commands by the names a configuration file gives them (kebab case, as mpv's are).
+constexpr NamedCommand play_commands[] = {
+    {Command::pause, "pause"},
+    {Command::seek_back_10s, "seek-back-10s"},
+    {Command::seek_forward_10s, "seek-forward-10s"},
+    {Command::seek_back_60s, "seek-back-60s"},
+    {Command::seek_forward_60s, "seek-forward-60s"},
+    {Command::screen_farther, "screen-farther"},
+    {Command::screen_nearer, "screen-nearer"},
+    {Command::ipd_narrower, "ipd-narrower"},
+    {Command::ipd_wider, "ipd-wider"},
+    {Command::swap_eyes, "swap-eyes"},
+    {Command::calibration_grid, "calibration-grid"},
+    {Command::fullscreen, "fullscreen"},
+    {Command::next_file, "playlist-next"},
+    {Command::previous_file, "playlist-prev"},
+    {Command::show_progress, "show-progress"},
+    {Command::keep_progress, "keep-progress"},
+    {Command::volume_down, "volume-down"},
+    {Command::volume_up, "volume-up"},
+    {Command::mute, "mute"},
+    {Command::next_audio_track, "cycle-audio"},
+    {Command::help, "help"},
+    {Command::quit, "quit"},
+};
+
+struct NamedKey {
+  N key;
+  std::string_view shown;                         // in the help
+  std::initializer_list<std::string_view> names;  // as a configuration file may write it (any case)
+};
+const NamedKey named_keys[] = {
+    {N::space, "space", {"space"}},
+    {N::left, "left", {"left"}},
+    {N::right, "right", {"right"}},
+    {N::up, "up", {"up"}},
+    {N::down, "down", {"down"}},
+    {N::page_up, "PgUp", {"pgup"}},
+    {N::page_down, "PgDn", {"pgdwn", "pgdn"}},
+    {N::escape, "Esc", {"esc"}},
+    {N::enter, "Enter", {"enter"}},
+    {N::tab, "Tab", {"tab"}},
+    {N::backspace, "Backspace", {"bs", "backspace"}},
+};
+
+bool same_ignoring_case(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; };
+    if (lower(a[i]) != lower(b[i])) return false;
+  }
+  return true;
+}
+
+// The one code point `text` is in UTF-8; nullopt when it is more, less or not UTF-8.
+std::optional<char32_t> single_code_point(std::string_view text) {
+  if (text.empty()) return std::nullopt;
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text[i]); };
+  const unsigned char lead = byte(0);
+  std::size_t length = 0;
+  char32_t c = 0;
+  if (lead < 0x80) {
+    length = 1;
+    c = lead;
+  } else if ((lead & 0xE0) == 0xC0) {
+    length = 2;
+    c = lead & 0x1F;
+  } else if ((lead & 0xF0) == 0xE0) {
+    length = 3;
+    c = lead & 0x0F;
+  } else if ((lead & 0xF8) == 0xF0) {
+    length = 4;
+    c = lead & 0x07;
+  } else {
+    return std::nullopt;
+  }
+  if (text.size() != length) return std::nullopt;
+  for (std::size_t i = 1; i < length; ++i) {
+    if ((byte(i) & 0xC0) != 0x80) return std::nullopt;
+    c = (c << 6) | (byte(i) & 0x3F);
+  }
+  // Control characters are keys a terminal or window reports by name, or not at all.
+  if (c < 0x20 || c == 0x7F) return std::nullopt;
+  return c;
+}
+
+std::string utf8(char32_t c) {
+  std::string out;
+  if (c < 0x80) {
+    out += static_cast<char>(c);
+  } else if (c < 0x800) {
+    out += static_cast<char>(0xC0 | (c >> 6));
+    out += static_cast<char>(0x80 | (c & 0x3F));
+  } else if (c < 0x10000) {
+    out += static_cast<char>(0xE0 | (c >> 12));
+    out += static_cast<char>(0x80 | ((c >> 6) & 0x3F));
+    out += static_cast<char>(0x80 | (c & 0x3F));
+  } else {
+    out += static_cast<char>(0xF0 | (c >> 18));
+    out += static_cast<char>(0x80 | ((c >> 12) & 0x3F));
+    out += static_cast<char>(0x80 | ((c >> 6) & 0x3F));
+    out += static_cast<char>(0x80 | (c & 0x3F));
+  }
+  return out;
+}
+
+// What a key rebound to `command` does, for its line of the help: its row's help when the row has
+// no other command, else the command's name.
+std::string rebound_help(Command command) {
+  for (const KeyBinding& row : key_bindings()) {
+    if (row.scope != KeyScope::play) continue;
+    bool has = false, others = false;
+    for (const auto& [press, c] : row.keys) (c == command ? has : others) = true;
+    if (has && !others) return std::string(row.help);
+  }
+  std::string name(command_name(command));
+  std::replace(name.begin(), name.end(), '-', ' ');
+  return name;
+}
+
+}  // namespace
+
+std::optional<Command> command_for(KeyScope scope, const KeyPress& key, const KeyRebindings& rebindings) {
+  if (scope == KeyScope::play)
+    for (const KeyRebinding& r : rebindings)
+      if (matches(r.key, key)) return r.command;
   for (const KeyBinding& row : key_bindings()) {
     if (row.scope != scope) continue;
-    for (const auto& [press, command] : row.keys) {
-      if (press.named != N::none ? key.is(press.named) : (!key.ctrl && !key.alt && key.is(press.character)))
-        return command;
-    }
+    for (const auto& [press, command] : row.keys)
+      if (matches(press, key)) return command;
   }
   return std::nullopt;
 }
 
-std::vector<std::string> key_help(KeyScope scope) {
+std::vector<std::string> key_help(KeyScope scope, const KeyRebindings& rebindings) {
+  const KeyRebindings& changed = scope == KeyScope::play ? rebindings : KeyRebindings{};
   std::vector<std::string> lines;
-  for (const KeyBinding& row : key_bindings())
-    if (row.scope == scope) lines.push_back(fmt::format("{}: {}", row.label, row.help));
+  for (const KeyBinding& row : key_bindings()) {
+    if (row.scope != scope) continue;
+    std::string label;
+    bool rebound = false;
+    for (const auto& [press, command] : row.keys) {
+      if (rebinding_of(press, changed)) {
+        rebound = true;
+        continue;
+      }
+      // A row a rebinding changed names each key it still has, a letter once (s for s and S),
+      // as the rows' own labels do.
+      const bool upper = press.named == N::none && press.character >= U'A' && press.character <= U'Z';
+      if (upper && !rebinding_of(KeyPress::of(press.character - U'A' + U'a'), changed) &&
+          std::any_of(row.keys.begin(), row.keys.end(),
+                      [&](const auto& k) { return k.first.is(press.character - U'A' + U'a'); }))
+        continue;
+      label += (label.empty() ? "" : " ") + key_name(press);
+    }
+    if (!rebound)
+      lines.push_back(fmt::format("{}: {}", row.label, row.help));
+    else if (!label.empty())
+      lines.push_back(fmt::format("{}: {}", label, row.help));
+  }
+  for (const KeyRebinding& r : changed)
+    if (r.command) lines.push_back(fmt::format("{}: {}", key_name(r.key), rebound_help(*r.command)));
   return lines;
+}
+
+std::string_view command_name(Command command) {
+  for (const NamedCommand& c : play_commands)
+    if (c.command == command) return c.name;
+  return {};
+}
+
+std::optional<Command> command_named(std::string_view name) {
+  for (const NamedCommand& c : play_commands)
+    if (c.name == name) return c.command;
+  return std::nullopt;
+}
+
+std::vector<std::string> play_command_names() {
+  std::vector<std::string> names;
+  for (const NamedCommand& c : play_commands) names.emplace_back(c.name);
+  return names;
+}
+
+std::optional<KeyPress> parse_key_name(std::string_view name) {
+  for (const NamedKey& k : named_keys)
+    for (const std::string_view n : k.names)
+      if (same_ignoring_case(name, n)) return KeyPress::of(k.key);
+  if (const std::optional<char32_t> c = single_code_point(name); c && *c != U' ') return KeyPress::of(*c);
+  return std::nullopt;
+}
+
+std::string key_name(const KeyPress& key) {
+  if (key.named == N::none) return utf8(key.character);
+  for (const NamedKey& k : named_keys)
+    if (k.key == key.named) return std::string(k.shown);
+  return "?";
 }
 
 std::string key_table_markdown(KeyScope scope) {

@@ -89,12 +89,37 @@ struct KeyBinding {
 
 const std::vector<KeyBinding>& key_bindings();
 
-// What `key` means in `scope`. A printable key matches with Shift (it is the character typed) but
-// not with Ctrl or Alt; a named key (arrows, Tab, …) matches with any modifier.
-std::optional<Command> command_for(KeyScope scope, const KeyPress& key);
+// A key of `nelf play` given another command by the user (the configuration file's [keys]):
+// nullopt unbinds it ("ignore", as mpv's input.conf says).
+struct KeyRebinding {
+  KeyPress key;
+  std::optional<Command> command;
+};
+using KeyRebindings = std::vector<KeyRebinding>;
 
-// "label: help", one line per row of `scope`.
-std::vector<std::string> key_help(KeyScope scope);
+// What `key` means in `scope`, after `rebindings` (which change play's keys only). A printable key
+// matches with Shift (it is the character typed) but not with Ctrl or Alt; a named key (arrows,
+// Tab, …) matches with any modifier.
+std::optional<Command> command_for(KeyScope scope, const KeyPress& key, const KeyRebindings& rebindings = {});
+
+// "label: help", one line per row of `scope`; with `rebindings`, a row names the keys it still has
+// (none: it is left out) and each rebound key has a line of its own, so that h shows what the keys do.
+std::vector<std::string> key_help(KeyScope scope, const KeyRebindings& rebindings = {});
+
+// The name of play's command `command` in the configuration file ("swap-eyes"); "" for the
+// commands that are not play's.
+std::string_view command_name(Command command);
+// Play's command named `name`; nullopt for no such name.
+std::optional<Command> command_named(std::string_view name);
+// Every name command_named() knows, in the table's order.
+std::vector<std::string> play_command_names();
+
+// The key a configuration file names: one character ("x", "+", "é") or a key name as mpv's
+// input.conf writes it, any case (SPACE, LEFT, RIGHT, UP, DOWN, PGUP, PGDWN, ESC, ENTER, TAB, BS);
+// nullopt for anything else.
+std::optional<KeyPress> parse_key_name(std::string_view name);
+// The name the help gives `key` ("x", "space", "left", "Esc").
+std::string key_name(const KeyPress& key);
 
 // The README's table of `scope`'s keys (play, defects: key | does; calibrate: key | changes | profile key).
 std::string key_table_markdown(KeyScope scope);

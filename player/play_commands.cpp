@@ -83,8 +83,10 @@ void PlayCommands::seek_to(double seconds, const std::string& what) {
 
 void PlayCommands::seek_by(double delta) {
   const double from = state_.current ? state_.current->pts_s : sound_.clock().now();
-  double target = std::max(0.0, from + delta);
-  if (duration_s_) target = std::min(target, std::max(0.0, *duration_s_ - 0.001));
+  seek_shown(from + delta);
+}
+
+void PlayCommands::seek_shown(double target) {
   seek_to(target, "");
   // mpv's OSD after a seek: where it is now, on the time line and the bar.
   message_.clear();
@@ -199,7 +201,7 @@ std::optional<PlayEnd> PlayCommands::apply(Command command) {
     }
     case Command::help: {
       // Each press shows the next line on screen; the first also prints them all.
-      const std::vector<std::string> lines = key_help(KeyScope::play);
+      const std::vector<std::string> lines = key_help(KeyScope::play, options_.key_rebindings);
       if (help_line_ == 0 && !options_.quiet)
         for (const std::string& line : lines) fmt::print(stderr, "nelf: key {}\n", line);
       say(lines[help_line_++ % lines.size()]);

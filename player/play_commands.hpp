@@ -58,6 +58,10 @@ class PlayCommands {
   // Goes to `seconds` in the movie's time (clamped to it) as a seek key does, saying `what` on screen
   // ("" for nothing).
   void seek_to(double seconds, const std::string& what);
+  // Seeks `delta_s` from the frame on screen (as the arrows do), or to `target_s`, with the time
+  // line and the seek bar after it as mpv's OSD.
+  void seek_by(double delta_s);
+  void seek_shown(double target_s);
   // A message on screen for two seconds (when on-screen messages are on); the frame is redrawn.
   void say(std::string text);
   // Takes the message off the screen once its two seconds are up.
@@ -67,7 +71,6 @@ class PlayCommands {
   FrameOverlays overlays() const;
 
  private:
-  void seek_by(double delta_s);
   std::optional<PlayEnd> other_file(bool next);
   // The time line and the seek bar for two seconds (after a seek, key o).
   void show_progress();

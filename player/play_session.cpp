@@ -6,6 +6,7 @@
 
 #include "core/image_library.hpp"
 #include "core/user_error.hpp"
+#include "player/ipc_commands.hpp"
 #include "player/key_bindings.hpp"
 
 namespace nelf::playback {
@@ -62,6 +63,7 @@ PlaySession::PlaySession(Display& display_, Source& source_, const PlayerOptions
       compositor(options.profile, options.compositor, layout, display.context()),
       target(checked_target(display, compositor, layout, options)),
       log(options.log_frames),
+      ipc(options.ipc_server.empty() ? nullptr : std::make_unique<IpcServer>(options.ipc_server)),
       sound(source, options),
       clock(paused_master_clock(sound, options)),
       refresh_period(1.0 / display.refresh_hz()),
@@ -93,8 +95,13 @@ std::optional<PlayEnd> PlaySession::take_keys_and_events() {
   for (const KeyPress& key : display.poll_events()) keys.push_back(key);
   std::optional<PlayEnd> why;
   for (const KeyPress& key : keys)
-    if (const std::optional<Command> command = command_for(KeyScope::play, key))
+    if (const std::optional<Command> command = command_for(KeyScope::play, key, options.key_rebindings))
       if (const std::optional<PlayEnd> end = commands.apply(*command); end && !why) why = end;
+  if (ipc) {
+    IpcTarget remote{state, commands, info.duration_s, options.media_path, options.key_rebindings, {}};
+    ipc->poll([&](std::string_view line) { return answer_ipc_request(line, remote); });
+    if (remote.end && !why) why = remote.end;
+  }
   if (why) return why;
   if (display.close_requested()) return PlayEnd::window_closed;
   if (stop && stop->load()) return PlayEnd::interrupted;

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "player/frame_log.hpp"
 #include "player/frame_queue.hpp"
 #include "player/frame_scheduler.hpp"
+#include "player/ipc_server.hpp"
 #include "player/play_commands.hpp"
 #include "player/play_sound.hpp"
 #include "player/player.hpp"
@@ -58,6 +60,7 @@ struct PlaySession {
   FrameCompositor compositor;
   const GlPackedTarget target;  // made once the eyes are checked to fit it
   FrameLog log;
+  std::unique_ptr<IpcServer> ipc;  // --input-ipc-server, before the threads start: a bad path stops play at once
   PlaySound sound;
   PlaybackClock& clock;  // the master clock, paused until the first frame is on screen
   const double refresh_period;

@@ -20,6 +20,7 @@
 #include "inputs/source.hpp"
 #include "optics/profile.hpp"
 #include "player/frame_scheduler.hpp"
+#include "player/key_bindings.hpp"
 #include "player/stepped_clock.hpp"
 
 namespace nelf {
@@ -35,8 +36,11 @@ struct PlayerOptions {
   std::vector<std::string> audio_languages;  // --alang: the first track in the first of these
   double volume = 100.0;                     // --volume, 0 to 130 (100: as decoded)
   bool mute = false;
-  std::string log_frames;  // CSV of every refresh (diagnostics); "" = none
-  bool quiet = false;      // no "playing …" / audio status lines on stderr (warnings still are)
+  std::string log_frames;        // CSV of every refresh (diagnostics); "" = none
+  bool quiet = false;            // no "playing …" / audio status lines on stderr (warnings still are)
+  KeyRebindings key_rebindings;  // the configuration file's [keys]
+  std::string ipc_server;        // --input-ipc-server: mpv's JSON IPC on this socket; "" = none
+  std::string media_path;        // the input as given (the IPC's path and filename properties)
   // Each key's change said on screen for 2 s. Off (tests): while a message shows, frames are
   // composited with GL (the text is drawn there), so without them the CPU path and its frames
   // composited ahead are seen right after a key.

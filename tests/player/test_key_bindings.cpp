@@ -2,6 +2,7 @@
 // and the README's key tables all come from it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -59,6 +60,62 @@ TEST(KeyBindings, HelpIsOneLinePerRow) {
   EXPECT_EQ(CalibrationControls::help_lines().front(), "Tab: adjust both eyes / left / right");
   EXPECT_EQ(DefectMarking::help_lines(), key_help(KeyScope::defects));
   EXPECT_EQ(DefectMarking::help_lines().back(), "q Esc: quit (saves the defect map)");
+}
+
+// The configuration file's [keys]: a rebound key means its new command in play only, the key it
+// took loses its old one, and h says so: the key's own line, the old row without it.
+TEST(KeyBindings, RebindingsChangeWhatPlaysKeysDoAndTheHelp) {
+  const KeyRebindings keys = {{KeyPress::of(U'x'), Command::swap_eyes},
+                              {KeyPress::of(U's'), std::nullopt},
+                              {KeyPress::of(KeyPress::Named::left), Command::quit}};
+  EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U'x'), keys), Command::swap_eyes);
+  EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U'x')), std::nullopt);
+  EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U's'), keys), std::nullopt);  // "ignore"
+  EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U'S'), keys), Command::swap_eyes);
+  EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(KeyPress::Named::left), keys), Command::quit);
+  EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(KeyPress::Named::right), keys), Command::seek_forward_10s);
+  // Not calibrate's keys.
+  EXPECT_EQ(command_for(KeyScope::calibrate, KeyPress::of(KeyPress::Named::left), keys), Command::shift_left);
+
+  const auto help = key_help(KeyScope::play, keys);
+  const auto has = [&](const std::string& line) { return std::find(help.begin(), help.end(), line) != help.end(); };
+  EXPECT_TRUE(has("x: swap the eyes"));
+  EXPECT_TRUE(has("S: swap the eyes"));  // s is ignored now, S still swaps
+  EXPECT_FALSE(has("s: swap the eyes"));
+  EXPECT_TRUE(has("right: seek 10 s back / forward"));
+  EXPECT_TRUE(has("left: quit"));
+  EXPECT_TRUE(has("q Esc: quit"));
+  EXPECT_EQ(key_help(KeyScope::calibrate, keys), key_help(KeyScope::calibrate));
+  // A command of a row with two gets its name.
+  EXPECT_EQ(key_help(KeyScope::play, {{KeyPress::of(U'z'), Command::seek_back_60s}}).back(), "z: seek back 60s");
+}
+
+TEST(KeyBindings, KeyNamesAreMpvsAndOneCharacter) {
+  EXPECT_EQ(parse_key_name("SPACE")->named, KeyPress::Named::space);
+  EXPECT_EQ(parse_key_name("left")->named, KeyPress::Named::left);
+  EXPECT_EQ(parse_key_name("PGDWN")->named, KeyPress::Named::page_down);
+  EXPECT_EQ(parse_key_name("Esc")->named, KeyPress::Named::escape);
+  EXPECT_EQ(parse_key_name("BS")->named, KeyPress::Named::backspace);
+  EXPECT_EQ(parse_key_name("x")->character, U'x');
+  EXPECT_EQ(parse_key_name("+")->character, U'+');
+  EXPECT_EQ(parse_key_name("\xc3\xa9")->character, U'\u00e9');  // é
+  for (const char* bad : {"", "xy", "Ctrl+x", " ", "\x01", "\xc3"}) EXPECT_EQ(parse_key_name(bad), std::nullopt) << bad;
+  EXPECT_EQ(key_name(*parse_key_name("\xc3\xa9")), "\xc3\xa9");
+  EXPECT_EQ(key_name(KeyPress::of(KeyPress::Named::escape)), "Esc");
+}
+
+TEST(KeyBindings, EveryPlayCommandHasAName) {
+  for (const KeyBinding& row : key_bindings()) {
+    if (row.scope != KeyScope::play) continue;
+    for (const auto& [press, command] : row.keys) {
+      const std::string_view name = command_name(command);
+      EXPECT_FALSE(name.empty()) << row.label;
+      EXPECT_EQ(command_named(name), command) << name;
+    }
+  }
+  EXPECT_EQ(command_named("swap-eyes"), Command::swap_eyes);
+  EXPECT_EQ(command_named("swap_eyes"), std::nullopt);
+  EXPECT_EQ(command_name(Command::rotate_less), "");  // calibrate's
 }
 
 TEST(KeyBindings, ReadmeTablesAreTheTable) {

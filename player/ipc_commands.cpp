@@ -1,0 +1,223 @@
+#include "player/ipc_commands.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <sstream>
+#include <vector>
+
+namespace nelf::playback {
+
+namespace {
+
+using json = nlohmann::json;
+
+// mpv's error strings, which clients compare against.
+constexpr const char* success = "success";
+constexpr const char* invalid_parameter = "invalid parameter";
+constexpr const char* property_not_found = "property not found";
+constexpr const char* property_unavailable = "property unavailable";
+
+struct Reply {
+  const char* error = success;
+  std::optional<json> data;
+};
+
+// A value mpv's commands take as a number: a JSON number or the text of one.
+std::optional<double> number(const json& value) {
+  if (value.is_number()) return value.get<double>();
+  if (!value.is_string()) return std::nullopt;
+  const std::string text = value.get<std::string>();
+  std::size_t used = 0;
+  try {
+    const double d = std::stod(text, &used);
+    if (used == text.size()) return d;
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
+// A flag as mpv takes it: true/false, or "yes"/"no".
+std::optional<bool> flag(const json& value) {
+  if (value.is_boolean()) return value.get<bool>();
+  if (value == "yes") return true;
+  if (value == "no") return false;
+  return std::nullopt;
+}
+
+// Where play is: the frame on screen, or where a seek goes until its first frame shows (as mpv
+// answers at once after a seek).
+double time_pos(const IpcTarget& t) {
+  if (t.state.awaiting_seek) return t.state.seek_target_s;
+  return t.state.current ? t.state.current->pts_s : 0.0;
+}
+
+struct Property {
+  std::string_view name;
+  // nullopt: there is no value now ("property unavailable"); a property without get is write-only.
+  std::optional<json> (*get)(IpcTarget&);
+  // false: the value is not one the property takes ("invalid parameter"); null: read-only.
+  bool (*set)(IpcTarget&, const json&);
+};
+
+const Property properties[] = {
+    {"pause", [](IpcTarget& t) -> std::optional<json> { return t.state.paused; },
+     [](IpcTarget& t, const json& v) {
+       const std::optional<bool> paused = flag(v);
+       if (!paused) return false;
+       if (*paused != t.state.paused) t.commands.apply(Command::pause);
+       return true;
+     }},
+    {"time-pos", [](IpcTarget& t) -> std::optional<json> { return time_pos(t); },
+     [](IpcTarget& t, const json& v) {
+       const std::optional<double> to = number(v);
+       if (!to) return false;
+       t.commands.seek_shown(*to);
+       return true;
+     }},
+    {"duration",
+     [](IpcTarget& t) -> std::optional<json> {
+       if (!t.duration_s) return std::nullopt;
+       return *t.duration_s;
+     },
+     nullptr},
+    {"percent-pos",
+     [](IpcTarget& t) -> std::optional<json> {
+       if (!t.duration_s || *t.duration_s <= 0) return std::nullopt;
+       return 100.0 * time_pos(t) / *t.duration_s;
+     },
+     nullptr},
+    {"filename", [](IpcTarget& t) -> std::optional<json> { return std::filesystem::path(t.path).filename().string(); },
+     nullptr},
+    {"path", [](IpcTarget& t) -> std::optional<json> { return t.path; }, nullptr},
+};
+
+const Property* property_named(const json& name) {
+  if (!name.is_string()) return nullptr;
+  for (const Property& p : properties)
+    if (p.name == name.get<std::string>()) return &p;
+  return nullptr;
+}
+
+Reply set_property(IpcTarget& t, const std::vector<json>& args) {
+  if (args.size() != 2) return {invalid_parameter, {}};
+  const Property* p = property_named(args[0]);
+  if (!p) return {property_not_found, {}};
+  if (!p->set || !p->set(t, args[1])) return {invalid_parameter, {}};
+  return {};
+}
+
+struct IpcCommand {
+  std::string_view name;
+  Reply (*run)(IpcTarget&, const std::vector<json>& args);
+};
+
+const IpcCommand commands[] = {
+    {"quit",
+     [](IpcTarget& t, const std::vector<json>&) {
+       t.end = PlayEnd::quit_key;
+       return Reply{};
+     }},
+    {"get_property",
+     [](IpcTarget& t, const std::vector<json>& args) {
+       if (args.size() != 1) return Reply{invalid_parameter, {}};
+       const Property* p = property_named(args[0]);
+       if (!p || !p->get) return Reply{property_not_found, {}};
+       std::optional<json> value = p->get(t);
+       if (!value) return Reply{property_unavailable, {}};
+       return Reply{success, std::move(value)};
+     }},
+    {"set_property", set_property},
+    {"set", set_property},
+    {"cycle",
+     [](IpcTarget& t, const std::vector<json>& args) {
+       if (args.empty() || args.size() > 2) return Reply{invalid_parameter, {}};
+       const Property* p = property_named(args[0]);
+       if (!p) return Reply{property_not_found, {}};
+       // Only a flag cycles here (mpv's cycle of a choice property has no such property yet).
+       const std::optional<json> now = p->get ? p->get(t) : std::nullopt;
+       if (!now || !now->is_boolean() || !p->set) return Reply{invalid_parameter, {}};
+       p->set(t, !now->get<bool>());
+       return Reply{};
+     }},
+    {"seek",
+     [](IpcTarget& t, const std::vector<json>& args) {
+       if (args.empty() || args.size() > 3) return Reply{invalid_parameter, {}};
+       const std::optional<double> amount = number(args[0]);
+       if (!amount) return Reply{invalid_parameter, {}};
+       std::string mode = "relative";
+       if (args.size() >= 2) {
+         if (!args[1].is_string()) return Reply{invalid_parameter, {}};
+         mode = args[1].get<std::string>();
+         // mpv's precision flags: nelf's seeks are always exact (to the frame).
+         for (const std::string_view exact : {"+exact", "+keyframes"})
+           if (mode.size() > exact.size() && mode.ends_with(exact)) mode.resize(mode.size() - exact.size());
+       }
+       if (mode == "relative") {
+         t.commands.seek_by(*amount);
+       } else if (mode == "absolute") {
+         t.commands.seek_shown(*amount);
+       } else if (mode == "absolute-percent" || mode == "relative-percent") {
+         if (!t.duration_s) return Reply{property_unavailable, {}};
+         const double s = *amount / 100.0 * *t.duration_s;
+         if (mode == "absolute-percent")
+           t.commands.seek_shown(s);
+         else
+           t.commands.seek_by(s);
+       } else {
+         return Reply{invalid_parameter, {}};
+       }
+       return Reply{};
+     }},
+    {"keypress",
+     [](IpcTarget& t, const std::vector<json>& args) {
+       if (args.size() != 1 || !args[0].is_string()) return Reply{invalid_parameter, {}};
+       const std::optional<KeyPress> key = parse_key_name(args[0].get<std::string>());
+       if (!key) return Reply{invalid_parameter, {}};
+       // The key as if typed: the same binding table, rebindings and commands.
+       if (const std::optional<Command> command = command_for(KeyScope::play, *key, t.keys))
+         if (const std::optional<PlayEnd> end = t.commands.apply(*command); end && !t.end) t.end = end;
+       return Reply{};
+     }},
+};
+
+Reply run(IpcTarget& t, const std::vector<json>& words) {
+  if (words.empty() || !words[0].is_string()) return {invalid_parameter, {}};
+  for (const IpcCommand& c : commands)
+    if (c.name == words[0].get<std::string>()) return c.run(t, std::vector<json>(words.begin() + 1, words.end()));
+  return {invalid_parameter, {}};
+}
+
+}  // namespace
+
+std::string answer_ipc_request(std::string_view line, IpcTarget& target) {
+  const std::size_t first = line.find_first_not_of(" \t");
+  if (first == std::string_view::npos) return "";
+  if (line[first] != '{') {
+    std::vector<json> words;
+    std::istringstream in{std::string(line)};
+    for (std::string word; in >> word;) words.emplace_back(word);
+    run(target, words);
+    return "";
+  }
+  json reply = json::object();
+  const json request = json::parse(line, nullptr, false);
+  if (request.is_discarded() || !request.is_object()) {
+    reply["error"] = invalid_parameter;
+    return reply.dump();
+  }
+  // mpv's own: the request's id comes back, 0 when it had none.
+  reply["request_id"] = request.contains("request_id") ? request["request_id"] : json(0);
+  const auto command = request.find("command");
+  if (command == request.end() || !command->is_array()) {
+    reply["error"] = invalid_parameter;
+    return reply.dump();
+  }
+  Reply answer = run(target, command->get<std::vector<json>>());
+  if (answer.data) reply["data"] = std::move(*answer.data);
+  reply["error"] = answer.error;
+  return reply.dump();
+}
+
+}  // namespace nelf::playback

@@ -1,0 +1,80 @@
+// --input-ipc-server driven by socat, as mpv's scripts drive mpv: the replies are mpv's exact JSON,
+// seek, cycle pause and quit act on the player off screen, the socket is owner-only and removed at
+// exit, and a path that is not a socket is refused in one line.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <thread>
+
+#include "support/test_support.hpp"
+
+namespace nelf::test {
+namespace {
+
+std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
+
+TEST(IpcCli, SocatDrivesThePlayerWithMpvsJson) {
+  TempDir dir;
+  const auto sock = dir / "nelf.sock";
+  const auto ask = [&](const std::string& json) {
+    return run_command("echo " + shell_quote(json) + " | socat -t 10 - UNIX-CONNECT:" + q(sock)).out;
+  };
+  run_command("(env -u DISPLAY LP_NUM_THREADS=2 " + std::string(NELF_BINARY) +
+              " play synthetic:duration=60 --no-config --output offscreen --no-audio --input-ipc-server " + q(sock) +
+              " 2>" + q(dir / "err") + "; echo $? >" + q(dir / "status") + ") >/dev/null 2>&1 </dev/null &");
+  for (int i = 0; i < 300 && !std::filesystem::is_socket(sock); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(std::filesystem::is_socket(sock)) << read_file(dir / "err");
+  EXPECT_EQ(std::filesystem::status(sock).permissions() & std::filesystem::perms::all,
+            std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+
+  EXPECT_EQ(ask(R"({"command": ["get_property", "duration"], "request_id": 7})"),
+            "{\"data\":60.0,\"error\":\"success\",\"request_id\":7}\n");
+  EXPECT_EQ(ask(R"({"command": ["get_property", "filename"]})"),
+            "{\"data\":\"synthetic:duration=60\",\"error\":\"success\",\"request_id\":0}\n");
+  EXPECT_EQ(ask(R"({"command": ["seek", 30, "absolute"]})"), "{\"error\":\"success\",\"request_id\":0}\n");
+  double pos = 0;
+  for (int i = 0; i < 100 && pos < 30; ++i) {
+    const std::string r = ask(R"({"command": ["get_property", "time-pos"]})");
+    const auto at = r.find("\"data\":");
+    ASSERT_NE(at, std::string::npos) << r;
+    pos = std::stod(r.substr(at + 7));
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_GE(pos, 30.0);
+  EXPECT_LT(pos, 45.0);
+  EXPECT_EQ(ask(R"({"command": ["cycle", "pause"]})"), "{\"error\":\"success\",\"request_id\":0}\n");
+  EXPECT_EQ(ask(R"({"command": ["get_property", "pause"]})"),
+            "{\"data\":true,\"error\":\"success\",\"request_id\":0}\n");
+  EXPECT_EQ(ask("set pause no"), "");  // a text command: run, not answered
+  EXPECT_EQ(ask(R"({"command": ["get_property", "pause"]})"),
+            "{\"data\":false,\"error\":\"success\",\"request_id\":0}\n");
+  EXPECT_EQ(ask(R"({"command": ["get_property", "volumee"]})"),
+            "{\"error\":\"property not found\",\"request_id\":0}\n");
+  EXPECT_EQ(ask(R"({"command": ["seek", "soon"]})"), "{\"error\":\"invalid parameter\",\"request_id\":0}\n");
+  EXPECT_EQ(ask(R"({"command": ["no-such-command"]})"), "{\"error\":\"invalid parameter\",\"request_id\":0}\n");
+  EXPECT_EQ(ask("{not json"), "{\"error\":\"invalid parameter\"}\n");
+  EXPECT_EQ(ask(R"({"command": ["quit"], "request_id": 9})"), "{\"error\":\"success\",\"request_id\":9}\n");
+  for (int i = 0; i < 300 && !std::filesystem::exists(dir / "status"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(std::filesystem::exists(dir / "status")) << "quit did not end play";
+  EXPECT_EQ(read_file(dir / "status"), "0\n") << read_file(dir / "err");
+  EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(sock)));
+}
+
+TEST(IpcCli, APathThatIsNotASocketIsRefused) {
+  TempDir dir;
+  write_file(dir / "notes.txt", "keep");
+  const auto r = run_command("env -u DISPLAY LP_NUM_THREADS=2 " + std::string(NELF_BINARY) +
+                             " play synthetic:duration=1 --no-config --output offscreen --no-audio --quiet "
+                             "--input-ipc-server " +
+                             q(dir / "notes.txt"));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err, "nelf: --input-ipc-server " + (dir / "notes.txt").string() + ": exists and is not a socket\n");
+  EXPECT_EQ(read_file(dir / "notes.txt"), "keep");
+}
+
+}  // namespace
+}  // namespace nelf::test
