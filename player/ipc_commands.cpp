@@ -91,6 +91,20 @@ const Property properties[] = {
     {"filename", [](IpcTarget& t) -> std::optional<json> { return std::filesystem::path(t.path).filename().string(); },
      nullptr},
     {"path", [](IpcTarget& t) -> std::optional<json> { return t.path; }, nullptr},
+    {"volume", [](IpcTarget& t) -> std::optional<json> { return t.commands.volume(); },
+     [](IpcTarget& t, const json& v) {
+       const std::optional<double> to = number(v);
+       if (!to || *to < 0 || *to > 130) return false;  // --volume's range
+       t.commands.set_volume(*to);
+       return true;
+     }},
+    {"mute", [](IpcTarget& t) -> std::optional<json> { return t.commands.muted(); },
+     [](IpcTarget& t, const json& v) {
+       const std::optional<bool> mute = flag(v);
+       if (!mute) return false;
+       t.commands.set_mute(*mute);
+       return true;
+     }},
 };
 
 const Property* property_named(const json& name) {
@@ -117,6 +131,17 @@ const IpcCommand commands[] = {
     {"quit",
      [](IpcTarget& t, const std::vector<json>&) {
        t.end = PlayEnd::quit_key;
+       return Reply{};
+     }},
+    // The keys' > and <: at the playlist's end mpv stays on the file and says so, as they do.
+    {"playlist-next",
+     [](IpcTarget& t, const std::vector<json>&) {
+       if (const std::optional<PlayEnd> end = t.commands.apply(Command::next_file); end && !t.end) t.end = end;
+       return Reply{};
+     }},
+    {"playlist-prev",
+     [](IpcTarget& t, const std::vector<json>&) {
+       if (const std::optional<PlayEnd> end = t.commands.apply(Command::previous_file); end && !t.end) t.end = end;
        return Reply{};
      }},
     {"get_property",

@@ -62,6 +62,13 @@ class PlayCommands {
   // line and the seek bar after it as mpv's OSD.
   void seek_by(double delta_s);
   void seek_shown(double target_s);
+  // The sound's volume (0 to 130) and mute, as the keys 9 0 m change them, saying so on screen.
+  double volume() const { return sound_.volume(); }
+  bool muted() const { return sound_.muted(); }
+  void set_volume(double volume) { say(sound_.change_volume(volume - sound_.volume())); }
+  void set_mute(bool mute) {
+    if (mute != sound_.muted()) say(sound_.toggle_mute());
+  }
   // A message on screen for two seconds (when on-screen messages are on); the frame is redrawn.
   void say(std::string text);
   // Takes the message off the screen once its two seconds are up.

@@ -50,6 +50,8 @@ class PlaySound {
   // The volume (0 to 130, 100 as decoded) by `delta`; what it is now, in words ("Volume: 54 %").
   std::string change_volume(double delta);
   std::string toggle_mute();
+  double volume() const { return volume_; }
+  bool muted() const { return muted_; }
 
   std::int64_t decode_errors() const { return feeder_ ? feeder_->decode_errors() : 0; }
   // Stops feeding (before the source goes).

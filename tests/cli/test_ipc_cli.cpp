@@ -51,6 +51,14 @@ TEST(IpcCli, SocatDrivesThePlayerWithMpvsJson) {
   EXPECT_EQ(ask("set pause no"), "");  // a text command: run, not answered
   EXPECT_EQ(ask(R"({"command": ["get_property", "pause"]})"),
             "{\"data\":false,\"error\":\"success\",\"request_id\":0}\n");
+  EXPECT_EQ(ask(R"({"command": ["set_property", "volume", 54]})"), "{\"error\":\"success\",\"request_id\":0}\n");
+  EXPECT_EQ(ask(R"({"command": ["get_property", "volume"]})"),
+            "{\"data\":54.0,\"error\":\"success\",\"request_id\":0}\n");
+  EXPECT_EQ(ask(R"({"command": ["set_property", "volume", 200]})"),
+            "{\"error\":\"invalid parameter\",\"request_id\":0}\n");
+  EXPECT_EQ(ask(R"({"command": ["cycle", "mute"]})"), "{\"error\":\"success\",\"request_id\":0}\n");
+  EXPECT_EQ(ask(R"({"command": ["get_property", "mute"]})"),
+            "{\"data\":true,\"error\":\"success\",\"request_id\":0}\n");
   EXPECT_EQ(ask(R"({"command": ["get_property", "volumee"]})"),
             "{\"error\":\"property not found\",\"request_id\":0}\n");
   EXPECT_EQ(ask(R"({"command": ["seek", "soon"]})"), "{\"error\":\"invalid parameter\",\"request_id\":0}\n");
