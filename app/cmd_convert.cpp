@@ -114,9 +114,6 @@ void write_packed_still_raw(const StereoPair& views, const ConvertPlan& plan) {
   sink->finish();
 }
 
-// More than this pulls the two copies so far apart that the eyes no longer fuse them.
-constexpr double kMaxSubParallax = 10.0;
-
 void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
   VideoConvertRequest r;
   r.inputs = inputs;
@@ -161,12 +158,7 @@ void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
   if (!args.burn_subs && !args.sub_file.empty()) throw UserError("--sub-file needs --burn-subs", 2);
   if (!args.burn_subs && args.sub_parallax) throw UserError("--sub-parallax needs --burn-subs", 2);
   if (args.burn_subs) {
-    const double parallax = args.sub_parallax.value_or(0.0);
-    if (!std::isfinite(parallax) || std::abs(parallax) > kMaxSubParallax)
-      throw UserError(fmt::format("--sub-parallax must be -{0}..{0} (percent of the view width), got {1}",
-                                  kMaxSubParallax, parallax),
-                      2);
-    r.burn_subs = SubtitleBurn{args.sub_file, parallax};
+    r.burn_subs = SubtitleBurn{args.sub_file, parse_sub_parallax(args.sub_parallax)};
   }
   r.quiet = args.quiet;
   r.strict = args.strict;
@@ -213,6 +205,16 @@ void run_convert(const ConvertArgs& args) {
 }
 
 }  // namespace
+
+double parse_sub_parallax(const std::optional<double>& parallax) {
+  // More than this pulls the two copies so far apart that the eyes no longer fuse them.
+  constexpr double kMax = 10.0;
+  const double value = parallax.value_or(0.0);
+  if (!std::isfinite(value) || std::abs(value) > kMax)
+    throw UserError(fmt::format("--sub-parallax must be -{0}..{0} (percent of the view width), got {1}", kMax, value),
+                    2);
+  return value;
+}
 
 Signal resolve_signal(const Profile& profile, const std::string& name) {
   const std::string signal_name = name.empty() ? profile.signal : name;

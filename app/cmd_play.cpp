@@ -28,6 +28,7 @@
 #include "player/play_sound.hpp"
 #include "player/player.hpp"
 #include "player/playlist.hpp"
+#include "player/subtitle_choice.hpp"
 #include "player/watch_later.hpp"
 
 namespace nelf::app {
@@ -77,6 +78,15 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
       fmt::print(stderr, "nelf: layout {} as last time (--layout overrides)\n", *record.layout);
   }
   request.swap_eyes = args.swap_eyes || record.swap_eyes.value_or(false);
+  // The subtitles (--sub-file, a file beside the input, or its own first track) before the input
+  // says its line: a --sub-file that does not parse is then the only one said. A photo has none;
+  // a live window, a pipe or a URL is not looked into for them (one open of the input, behind
+  // --allow-network).
+  std::shared_ptr<SubtitleTrack> subtitles;
+  std::error_code not_a_file;
+  if (args.subtitles && !args.no_subs &&
+      (!args.sub_file.empty() || std::filesystem::is_regular_file(request.input, not_a_file)))
+    subtitles = choose_subtitles(request.input, args.sub_file, 0.0, false, args.quiet);
   const auto source = open_source_for_depth(request, common.compositor.depth, common.profile);
   const SourceInfo info = source->info();
 
@@ -117,6 +127,10 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
         fmt::print(stderr, "nelf: resuming at {} (--no-resume starts from the beginning)\n",
                    clock_time(*record.position_s));
     }
+  }
+  if (!info.still) {
+    options.subtitles = std::move(subtitles);
+    options.sub_parallax_percent = parse_sub_parallax(args.sub_parallax);
   }
   if (options.start_s && !info.seekable)
     throw UserError(
@@ -171,6 +185,9 @@ PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::
   if (args.start && !(*args.start >= 0)) throw UserError("--start must be 0 or more seconds", 2);
   if (args.image_duration && !(*args.image_duration > 0))
     throw UserError("--image-duration must be more than 0 seconds", 2);
+  if (args.no_subs && !args.sub_file.empty()) throw UserError("--no-subs and --sub-file contradict each other", 2);
+  if (args.no_subs && args.sub_parallax) throw UserError("--sub-parallax does nothing with --no-subs", 2);
+  parse_sub_parallax(args.sub_parallax);  // out of range: said before anything opens
   const std::vector<std::string> entries = expand_playlist(inputs, warn);
   if (entries.size() > 1 && !args.right.empty())
     throw UserError("--right gives the right view of one input; play the pairs one at a time", 2);
@@ -268,6 +285,13 @@ void add_play_command(CLI::App& app) {
                   "Show each photo this many seconds, then the next (default: until q or the next-file key)");
   cmd->add_flag("--no-resume", args->no_resume, "Start from the beginning, not where the file was stopped last time");
   add_sound_options(*cmd, *args);
+  args->subtitles = true;
+  cmd->add_option("--sub-file", args->sub_file,
+                  "Subtitles from this file (SRT, ASS/SSA, WebVTT, ...; default: INPUT.srt/.ass/.vtt beside the "
+                  "input, else the input's first subtitle track)");
+  cmd->add_flag("--no-subs", args->no_subs, "Show no subtitles");
+  cmd->add_option("--sub-parallax", args->sub_parallax,
+                  "The subtitles' depth in percent of the view width (positive = in front of the screen; default 0)");
   cmd->callback([args] {
     args->resume = !args->no_resume;
     args->remember = true;

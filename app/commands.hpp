@@ -23,6 +23,10 @@ using nelf::UserError;
 // Throws UserError (status 2) naming the accepted values.
 std::optional<StereoLayout> parse_layout_option(const std::string& name);
 
+// --sub-parallax of play and convert --burn-subs (percent of the view width; unset: 0). Throws
+// UserError (status 2) beyond ±10 %, where the two copies no longer fuse into one.
+double parse_sub_parallax(const std::optional<double>& parallax);
+
 // The input, layout and rendering options that convert and play share (one parser, one wording).
 struct CommonArgs {
   std::string input;

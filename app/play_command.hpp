@@ -31,6 +31,11 @@ struct PlayArgs : CommonArgs {
   bool resume = false;                   // play: on unless --no-resume
   bool remember = false;                 // play: keep each file's position and set-up between runs
   std::string input_ipc_server;
+  // play's subtitles (a game has none): --no-subs, --sub-file, --sub-parallax.
+  bool subtitles = false;
+  bool no_subs = false;
+  std::string sub_file;
+  std::optional<double> sub_parallax;
 };
 
 // The CommonArgs options (without INPUT) and play's own, on `cmd`.

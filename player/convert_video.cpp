@@ -27,13 +27,13 @@ extern "C" {
 #include "hmz_output/file_sink_drivers.hpp"
 #include "hmz_output/packing.hpp"
 #include "inputs/source_drivers.hpp"
-#include "inputs/subtitle_track.hpp"
 #include "inputs/synthetic_source.hpp"
 #include "inputs/video_source.hpp"
 #include "inputs/view_regions.hpp"
 #include "player/depth_input.hpp"
 #include "player/interrupt.hpp"
 #include "player/progress.hpp"
+#include "player/subtitle_choice.hpp"
 
 namespace nelf {
 
@@ -108,29 +108,6 @@ std::unique_ptr<FrameSink> open_frame_sink(const VideoConvertRequest& r, Source&
   return driver.open_file(std::move(request));
 }
 
-// The track --burn-subs draws: --sub-file, else a subtitle file beside the input (movie.srt,
-// movie.en.srt, …), else the input's own first subtitle stream. Opened (and a subtitle file parsed)
-// before any output exists.
-std::unique_ptr<SubtitleTrack> open_burned_subtitles(const VideoConvertRequest& r) {
-  const SubtitleBurn& burn = *r.burn_subs;
-  std::string file = burn.file;
-  if (file.empty()) {
-    const std::vector<std::string> beside = SubtitleTrack::beside(r.input);
-    if (!beside.empty())
-      file = beside.front();
-    else if (SubtitleTrack::has_subtitles(r.input))
-      file = r.input;
-    else
-      throw UserError(fmt::format("{}: no subtitles to burn in (no subtitle stream, no subtitle file beside it; "
-                                  "--sub-file FILE names one)",
-                                  printable(r.input)),
-                      1);
-  }
-  auto track = std::make_unique<SubtitleTrack>(file, r.start_s.value_or(0.0));
-  if (!r.quiet) fmt::print(stderr, "nelf: {}\n", printable(track->description()));
-  return track;
-}
-
 }  // namespace
 
 void convert_video(const VideoConvertRequest& r) {
@@ -141,9 +118,11 @@ void convert_video(const VideoConvertRequest& r) {
   // be burned in are the only line said; an input that is not there is said as such first.
   std::error_code missing;
   const bool subtitles_first = r.burn_subs && (!r.burn_subs->file.empty() || std::filesystem::exists(r.input, missing));
-  std::unique_ptr<SubtitleTrack> subtitles = subtitles_first ? open_burned_subtitles(r) : nullptr;
+  std::unique_ptr<SubtitleTrack> subtitles =
+      subtitles_first ? choose_subtitles(r.input, r.burn_subs->file, r.start_s.value_or(0.0), true, r.quiet) : nullptr;
   std::unique_ptr<Source> source = open_source_for_depth(request, r.compositor.depth, r.profile);
-  if (r.burn_subs && !subtitles) subtitles = open_burned_subtitles(r);
+  if (r.burn_subs && !subtitles)
+    subtitles = choose_subtitles(r.input, r.burn_subs->file, r.start_s.value_or(0.0), true, r.quiet);
   // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
   const ViewGeometry view = source->info().view;
   source->negotiate({stereo_prefilter_block(r.profile, r.compositor, view.width, view.height, view.aspect)});

@@ -4,6 +4,7 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -135,7 +136,8 @@ class FrameQueue {
 // dropped by the scheduler. (Skipping late frames here as well was measured and is worse when
 // decoding is the bottleneck: each decoded frame is late, so most were thrown away without the
 // decoder catching up; jumping ahead by seeking is worse still with long GOPs.)
-inline void decode_loop(Source& source, FrameQueue& queue) {
+// `draw` (may be empty) is done to each frame before it is queued: the subtitles.
+inline void decode_loop(Source& source, FrameQueue& queue, const std::function<void(StereoVideoFrame&)>& draw = {}) {
   try {
     for (;;) {
       const FrameQueue::Work work = queue.wait_for_work();
@@ -150,6 +152,7 @@ inline void decode_loop(Source& source, FrameQueue& queue) {
         queue.set_end(work.generation);
         continue;
       }
+      if (draw) draw(*frame);
       queue.push(std::move(*frame), work.generation);
     }
   } catch (...) {

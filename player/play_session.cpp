@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "compositor/overlays/subtitle_overlay.hpp"
 #include "core/image_library.hpp"
 #include "core/user_error.hpp"
 #include "player/ipc_commands.hpp"
@@ -12,6 +13,16 @@
 namespace nelf::playback {
 
 namespace {
+
+// The subtitles drawn into each frame on the decode thread: the frame's pts after a seek as before,
+// and the view's compositing untouched (GL, the tables and the frames composited ahead alike).
+std::function<void(StereoVideoFrame&)> subtitle_drawing(const PlayerOptions& options) {
+  if (!options.subtitles) return {};
+  return [track = options.subtitles, parallax = options.sub_parallax_percent](StereoVideoFrame& frame) {
+    const auto [width, height] = subtitle_canvas(frame);
+    draw_subtitles(frame, track->render(frame.pts_s, width, height, frame.aspect), parallax);
+  };
+}
 
 // The on-screen messages draw their text with OpenImageIO, loaded on first use: load it now
 // (~0.3 s) rather than as a hitch at the first key press. Without it the film still plays; the
@@ -74,7 +85,7 @@ PlaySession::PlaySession(Display& display_, Source& source_, const PlayerOptions
       scheduler(refresh_period, info.frame_rate > 0 && !info.live ? 1.0 / info.frame_rate : 0.0),
       view_format(source.negotiate(compositor.wanted_view_format(info.view))),
       queue(queue_capacity),
-      decoder([this] { decode_loop(source, queue); }),
+      decoder([this] { decode_loop(source, queue, subtitle_drawing(options)); }),
       commands(state, display, compositor, queue, sound, scheduler, options, info.duration_s, info.view, info.still),
       render_time(refresh_period),
       ticker(refresh_period) {}

@@ -18,6 +18,7 @@
 #include "hmz_output/display.hpp"
 #include "hmz_output/signal.hpp"
 #include "inputs/source.hpp"
+#include "inputs/subtitle_track.hpp"
 #include "optics/profile.hpp"
 #include "player/frame_scheduler.hpp"
 #include "player/key_bindings.hpp"
@@ -45,6 +46,10 @@ struct PlayerOptions {
   // composited with GL (the text is drawn there), so without them the CPU path and its frames
   // composited ahead are seen right after a key.
   bool on_screen_messages = true;
+  // Drawn into both views of every frame as it is decoded (null: none), the left eye's copy
+  // sub_parallax_percent of the view width right of the right eye's.
+  std::shared_ptr<SubtitleTrack> subtitles;
+  double sub_parallax_percent = 0.0;
   // Called after each new frame is rendered into the packed framebuffer, before present(); the
   // display's context is current (tests read the frame back here).
   std::function<void(const Display&, double pts_s)> after_render;

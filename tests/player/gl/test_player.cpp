@@ -24,6 +24,7 @@
 #include "hmz_output/display_drivers.hpp"
 #include "hmz_output/packing.hpp"
 #include "inputs/source_drivers.hpp"
+#include "inputs/subtitle_track.hpp"
 #include "player/frame_scheduler.hpp"
 #include "player/player.hpp"
 #include "player/stepped_clock.hpp"
@@ -437,6 +438,54 @@ TEST_F(PlayerTest, NoFrameCompositedAheadShowsAStateAKeyHasChanged) {
   EXPECT_GE(after_seek, 20) << "the seek back did not show the start again";
   for (std::size_t typed = 0; typed <= keys.size(); ++typed)
     EXPECT_GE(compared[typed], 5) << "too few frames in the same state in both runs after " << typed << " keys";
+}
+
+// Subtitles play drew into the frames as they are decoded: a cue from 0.6 s to 1.4 s of the clip is
+// in both eyes' panels while it shows and in neither before or after (the same clip played without
+// it on the stepped clock is the reference). The views arrive as block means here (80x45), so the
+// letters are a few pixels: a small difference counts.
+TEST_F(PlayerTest, ASubtitleCueShowsInBothEyesForItsTimeOnly) {
+  const auto clip = make_clip(dir_, 2);
+  test::write_file(dir_ / "cue.srt", "1\n00:00:00,600 --> 00:00:01,400\nHELLO 3D WORLD\n\n");
+  PlayerOptions options = silent_options();
+  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
+  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
+  std::map<double, std::array<Image, 2>> shown[2];  // [0]: no subtitles, [1]: the cue
+  for (int run : {0, 1}) {
+    options.clock = std::make_shared<playback::SteppedClock>();
+    options.subtitles = run == 1 ? std::make_shared<SubtitleTrack>((dir_ / "cue.srt").string(), 0.0) : nullptr;
+    auto display = open_display(options);
+    options.after_render = [&](const Display& d, double pts) {
+      const auto panel = [&](const EyeArea& a) {
+        return read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90);
+      };
+      shown[run][pts] = {panel(left), panel(right)};
+    };
+    auto source = test::open_input(clip);
+    EXPECT_EQ(play(*display, *source, options).end, PlayEnd::end_of_file);
+  }
+  int during = 0, outside = 0;
+  for (const auto& [pts, eyes] : shown[1]) {
+    if (!shown[0].count(pts) || std::abs(pts - 0.6) < 0.05 || std::abs(pts - 1.4) < 0.05) continue;
+    const bool showing = pts > 0.6 && pts < 1.4;
+    for (int e : {0, 1}) {
+      const Image& with = eyes[static_cast<std::size_t>(e)];
+      const Image& without = shown[0][pts][static_cast<std::size_t>(e)];
+      int changed = 0;
+      for (std::size_t i = 0; i < std::size_t{160} * 90; ++i) {
+        const float* a = &with.data()[i * 4];
+        const float* b = &without.data()[i * 4];
+        if (std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]) > 0.05f) ++changed;
+      }
+      if (showing)
+        EXPECT_GT(changed, 20) << "no subtitle at " << pts << " s in eye " << e;
+      else
+        EXPECT_EQ(changed, 0) << "a subtitle at " << pts << " s in eye " << e;
+    }
+    ++(showing ? during : outside);
+  }
+  EXPECT_GE(during, 15);
+  EXPECT_GE(outside, 20);
 }
 
 // On the tests' stepped clock the play loop's decisions follow from the timestamps and the refresh

@@ -1,0 +1,43 @@
+#include "player/subtitle_choice.hpp"
+
+#include <fmt/format.h>
+
+#include <vector>
+
+#include "core/printable.hpp"
+#include "core/user_error.hpp"
+
+namespace nelf {
+
+std::unique_ptr<SubtitleTrack> choose_subtitles(const std::string& input, const std::string& file, double start_s,
+                                                bool required, bool quiet) {
+  std::string chosen = file;
+  if (chosen.empty()) {
+    const std::vector<std::string> beside = SubtitleTrack::beside(input);
+    if (!beside.empty())
+      chosen = beside.front();
+    else if (SubtitleTrack::has_subtitles(input))
+      chosen = input;
+    else if (required)
+      throw UserError(fmt::format("{}: no subtitles to burn in (no subtitle stream, no subtitle file beside it; "
+                                  "--sub-file FILE names one)",
+                                  printable(input)),
+                      1);
+    else
+      return nullptr;
+  }
+  std::unique_ptr<SubtitleTrack> track;
+  try {
+    track = std::make_unique<SubtitleTrack>(chosen, start_s);
+  } catch (const UserError& e) {
+    // Subtitles found on their own (not named, not asked to be burned in) are no reason to refuse
+    // the movie.
+    if (required || !file.empty()) throw;
+    fmt::print(stderr, "nelf: warning: {}; playing without subtitles\n", printable(e.what()));
+    return nullptr;
+  }
+  if (!quiet) fmt::print(stderr, "nelf: {}\n", printable(track->description()));
+  return track;
+}
+
+}  // namespace nelf

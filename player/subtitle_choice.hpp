@@ -1,0 +1,18 @@
+#pragma once
+// Which subtitles play shows and convert --burn-subs draws: the same choice for both.
+#include <memory>
+#include <string>
+
+#include "inputs/subtitle_track.hpp"
+
+namespace nelf {
+
+// The subtitles for `input`: `file` (--sub-file) when given, else a subtitle file beside the input
+// (SubtitleTrack::beside), else the input's own first subtitle stream; `start_s` its --start.
+// `required` (--burn-subs): none found throws UserError; otherwise it is null, and subtitles found
+// but not usable are a warning. A `file` that is not usable always throws UserError. Says which
+// track it took unless `quiet`.
+std::unique_ptr<SubtitleTrack> choose_subtitles(const std::string& input, const std::string& file, double start_s,
+                                                bool required, bool quiet);
+
+}  // namespace nelf
