@@ -26,6 +26,8 @@ packages=(
   libgtest-dev libgmock-dev zsh fish
   # a real client of the JSON IPC socket (--input-ipc-server) for its tests, as mpv's scripts use
   socat
+  # mpv, a real player, reading what convert writes (which tracks it selects on its own)
+  mpv
   # the package checks (tests/package): the man page rendered as lintian does, lintian itself,
   # AppStream validation and the MIME database
   man-db lintian appstream shared-mime-info
