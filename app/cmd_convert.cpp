@@ -9,6 +9,7 @@
 
 #include <unistd.h>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include "app/commands.hpp"
@@ -42,6 +43,8 @@ struct ConvertArgs : CommonArgs {
   bool burn_subs = false;
   std::string sub_file;
   std::optional<double> sub_parallax;
+  std::string sid = "auto";
+  std::vector<std::string> slang;
 };
 
 // Inputs the still driver reads (OpenImageIO) become one image; everything else (and `synthetic:`)
@@ -157,8 +160,12 @@ void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
   }
   if (!args.burn_subs && !args.sub_file.empty()) throw UserError("--sub-file needs --burn-subs", 2);
   if (!args.burn_subs && args.sub_parallax) throw UserError("--sub-parallax needs --burn-subs", 2);
+  if (!args.burn_subs && (args.sid != "auto" || !args.slang.empty()))
+    throw UserError("--sid and --slang choose the track --burn-subs draws", 2);
+  if (args.sid == "no") throw UserError("--sid no: leave out --burn-subs to draw no subtitles", 2);
   if (args.burn_subs) {
-    r.burn_subs = SubtitleBurn{args.sub_file, parse_sub_parallax(args.sub_parallax)};
+    r.burn_subs = SubtitleBurn{
+        args.sub_file, parse_sub_parallax(args.sub_parallax), {parse_track_number(args.sid, "--sid"), args.slang}};
   }
   r.quiet = args.quiet;
   r.strict = args.strict;
@@ -205,6 +212,15 @@ void run_convert(const ConvertArgs& args) {
 }
 
 }  // namespace
+
+std::optional<int> parse_track_number(const std::string& value, const std::string& option) {
+  if (value == "auto" || value == "no") return std::nullopt;
+  int number = 0;
+  const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), number);
+  if (error != std::errc() || end != value.data() + value.size() || number < 1)
+    throw UserError(fmt::format("{} {}: a track number from 1, auto or no", option, printable(value)), 2);
+  return number;
+}
 
 double parse_sub_parallax(const std::optional<double>& parallax) {
   // More than this pulls the two copies so far apart that the eyes no longer fuse them.
@@ -375,6 +391,13 @@ void add_convert_command(CLI::App& app) {
   cmd->add_option("--sub-parallax", args->sub_parallax,
                   "Video, with --burn-subs: the subtitles' depth in percent of the view width (positive = in front "
                   "of the screen; default 0, on it)");
+  cmd->add_option("--sid", args->sid,
+                  "Video, with --burn-subs: the subtitle track by number (1 = the file's first subtitle stream, or "
+                  "--sub-file's), or auto")
+      ->capture_default_str();
+  cmd->add_option("--slang", args->slang,
+                  "Video, with --burn-subs: the subtitle track by language, first match wins: eng,ger")
+      ->delimiter(',');
   cmd->callback([args] { run_convert(*args); });
 }
 

@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -37,16 +36,6 @@ namespace {
 KeyRebindings& rebound_keys() {
   static KeyRebindings keys;
   return keys;
-}
-
-// --aid: N (the N-th audio track), auto (the file's default, or --alang's) or no (no sound).
-std::optional<int> audio_track_number(const std::string& aid) {
-  if (aid == "auto" || aid == "no") return std::nullopt;
-  int number = 0;
-  const auto [end, error] = std::from_chars(aid.data(), aid.data() + aid.size(), number);
-  if (error != std::errc() || end != aid.data() + aid.size() || number < 1)
-    throw UserError(fmt::format("--aid {}: a track number from 1, auto or no", printable(aid)), 2);
-  return number;
 }
 
 void warn(const std::string& line) { fmt::print(stderr, "nelf: warning: {}\n", printable(line)); }
@@ -84,9 +73,10 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
   // --allow-network).
   std::shared_ptr<SubtitleTrack> subtitles;
   std::error_code not_a_file;
-  if (args.subtitles && !args.no_subs &&
+  const SubtitleStreamChoice stream{parse_track_number(args.sid, "--sid"), args.slang};
+  if (args.subtitles && !args.no_subs && args.sid != "no" &&
       (!args.sub_file.empty() || std::filesystem::is_regular_file(request.input, not_a_file)))
-    subtitles = choose_subtitles(request.input, args.sub_file, 0.0, false, args.quiet);
+    subtitles = choose_subtitles(request.input, args.sub_file, 0.0, false, args.quiet, stream);
   const auto source = open_source_for_depth(request, common.compositor.depth, common.profile);
   const SourceInfo info = source->info();
 
@@ -95,7 +85,7 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
   options.signal = common.signal;
   options.compositor = common.compositor;
   options.audio = !args.no_audio && args.aid != "no";
-  options.audio_track = audio_track_number(args.aid);
+  options.audio_track = parse_track_number(args.aid, "--aid");
   if (args.aid == "no") options.no_audio_reason = "--aid no";
   options.audio_languages = args.alang;
   options.volume = args.volume;
@@ -172,7 +162,7 @@ PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::
   // Off screen, play renders headless like convert, on the GPU --gpu picks.
   if (args.output != "offscreen") refuse_gpu_for_live_output(args.gpu, "play");
   CommonOptions common = parse_common_options(args, false);
-  audio_track_number(args.aid);  // a bad --aid is said before any input opens
+  parse_track_number(args.aid, "--aid");  // a bad --aid is said before any input opens
   try {
     display_driver(args.output);
   } catch (const std::invalid_argument& e) {
@@ -188,6 +178,7 @@ PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::
   if (args.no_subs && !args.sub_file.empty()) throw UserError("--no-subs and --sub-file contradict each other", 2);
   if (args.no_subs && args.sub_parallax) throw UserError("--sub-parallax does nothing with --no-subs", 2);
   parse_sub_parallax(args.sub_parallax);  // out of range: said before anything opens
+  parse_track_number(args.sid, "--sid");
   const std::vector<std::string> entries = expand_playlist(inputs, warn);
   if (entries.size() > 1 && !args.right.empty())
     throw UserError("--right gives the right view of one input; play the pairs one at a time", 2);
@@ -289,7 +280,12 @@ void add_play_command(CLI::App& app) {
   cmd->add_option("--sub-file", args->sub_file,
                   "Subtitles from this file (SRT, ASS/SSA, WebVTT, ...; default: INPUT.srt/.ass/.vtt beside the "
                   "input, else the input's first subtitle track)");
-  cmd->add_flag("--no-subs", args->no_subs, "Show no subtitles");
+  cmd->add_flag("--no-subs", args->no_subs, "Show no subtitles (as --sid no)");
+  cmd->add_option("--sid", args->sid,
+                  "Subtitle track: its number (1 = the file's first subtitle stream, or --sub-file's), auto or no")
+      ->capture_default_str();
+  cmd->add_option("--slang", args->slang, "Subtitle track by language, first match wins: eng,ger (as tagged)")
+      ->delimiter(',');
   cmd->add_option("--sub-parallax", args->sub_parallax,
                   "The subtitles' depth in percent of the view width (positive = in front of the screen; default 0)");
   cmd->callback([args] {

@@ -27,6 +27,10 @@ std::optional<StereoLayout> parse_layout_option(const std::string& name);
 // UserError (status 2) beyond ±10 %, where the two copies no longer fuse into one.
 double parse_sub_parallax(const std::optional<double>& parallax);
 
+// --aid and --sid: N (the N-th track of its kind, from 1), auto or no; nullopt for auto and no.
+// Throws UserError (status 2) naming `option` otherwise.
+std::optional<int> parse_track_number(const std::string& value, const std::string& option);
+
 // The input, layout and rendering options that convert and play share (one parser, one wording).
 struct CommonArgs {
   std::string input;

@@ -36,6 +36,8 @@ struct PlayArgs : CommonArgs {
   bool no_subs = false;
   std::string sub_file;
   std::optional<double> sub_parallax;
+  std::string sid = "auto";  // a track number, auto or no
+  std::vector<std::string> slang;
 };
 
 // The CommonArgs options (without INPUT) and play's own, on `cmd`.

@@ -54,6 +54,7 @@ void blend_premultiplied(std::uint8_t* dst, int r, int g, int b, int a) {
 struct SubtitleTrack::Impl {
   std::string path;
   double offset_s = 0.0;
+  SubtitleStreamChoice choice;
   std::string description;
   ffmpeg::FormatContextPtr format;
   ffmpeg::CodecContextPtr codec;
@@ -80,8 +81,7 @@ struct SubtitleTrack::Impl {
     format.reset(raw);
     if (const int err = avformat_find_stream_info(format.get(), nullptr); err < 0)
       fail(fmt::format("cannot read subtitles: {}", av_error(err)));
-    const int index = av_find_best_stream(format.get(), AVMEDIA_TYPE_SUBTITLE, -1, -1, nullptr, 0);
-    if (index < 0) fail("no subtitle stream");
+    const int index = chosen_stream();
     stream = format->streams[index];
     // A movie's subtitles share its video's clock, whose first frame is time 0.
     const int video = av_find_best_stream(format.get(), AVMEDIA_TYPE_VIDEO, -1, -1, nullptr, 0);
@@ -118,6 +118,48 @@ struct SubtitleTrack::Impl {
     // A subtitle file that does not parse is refused now, not at its first line: every packet of
     // it is decoded up front (an external file is small; a movie's stream is read as it plays).
     read_to(first_packet_horizon());
+  }
+
+  // The stream `choice` names, else FFmpeg's best subtitle stream.
+  int chosen_stream() const {
+    std::vector<int> streams;
+    for (unsigned i = 0; i < format->nb_streams; ++i)
+      if (format->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_SUBTITLE) streams.push_back(static_cast<int>(i));
+    if (streams.empty()) fail("no subtitle stream");
+    const auto language = [&](int i) {
+      const AVDictionaryEntry* tag = av_dict_get(format->streams[i]->metadata, "language", nullptr, 0);
+      return std::string(tag ? tag->value : "");
+    };
+    const auto list = [&] {
+      std::string all;
+      for (std::size_t n = 0; n < streams.size(); ++n) {
+        const std::string lang = language(streams[n]);
+        all += fmt::format("{}{}: {}, {}", n ? "; " : "", n + 1, lang.empty() ? "no language" : lang,
+                           avcodec_get_name(format->streams[streams[n]]->codecpar->codec_id));
+      }
+      return all;
+    };
+    if (choice.number) {
+      if (*choice.number < 1 || *choice.number > static_cast<int>(streams.size()))
+        throw UserError(
+            fmt::format("{}: no subtitle track {} (--sid): {}", printable(path), *choice.number, printable(list())), 2);
+      return streams[static_cast<std::size_t>(*choice.number - 1)];
+    }
+    if (!choice.languages.empty()) {
+      const auto lower = [](std::string text) {
+        for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        return text;
+      };
+      for (const std::string& wanted : choice.languages)
+        for (const int i : streams)
+          if (lower(language(i)) == lower(wanted)) return i;
+      std::string asked;
+      for (const std::string& wanted : choice.languages) asked += (asked.empty() ? "" : ",") + wanted;
+      throw UserError(fmt::format("{}: no subtitle track in {} (--slang): {}", printable(path), printable(asked),
+                                  printable(list())),
+                      2);
+    }
+    return av_find_best_stream(format.get(), AVMEDIA_TYPE_SUBTITLE, -1, -1, nullptr, 0);
   }
 
   // External files hold only subtitles: read them whole. A movie: what its first seconds hold.
@@ -218,9 +260,11 @@ struct SubtitleTrack::Impl {
   }
 };
 
-SubtitleTrack::SubtitleTrack(const std::string& path, double start_s) : impl_(std::make_unique<Impl>()) {
+SubtitleTrack::SubtitleTrack(const std::string& path, double start_s, const SubtitleStreamChoice& choice)
+    : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
   impl_->offset_s = start_s;
+  impl_->choice = choice;
   impl_->open();
 }
 

@@ -12,14 +12,23 @@
 
 namespace nelf {
 
+// Which of a file's subtitle streams (--sid, --slang): the N-th (from 1), else the first tagged with
+// the first language of the list that one has, else FFmpeg's best.
+struct SubtitleStreamChoice {
+  std::optional<int> number;
+  std::vector<std::string> languages;
+  bool any() const { return number || !languages.empty(); }
+};
+
 class SubtitleTrack {
  public:
   // The first subtitle stream of `path` (a movie or a subtitle file). The caller's time 0 is the
   // movie's `start_s` (--start): a movie's own subtitles are timed on its video's clock (from its
   // start time), a subtitle file's from the start of the movie. Throws UserError (one line) when
   // the file cannot be read, has no subtitle stream that FFmpeg decodes, does not parse, or has
-  // bitmap subtitles (PGS, DVB, VobSub: not drawn yet).
-  SubtitleTrack(const std::string& path, double start_s);
+  // bitmap subtitles (PGS, DVB, VobSub: not drawn yet); status 2, listing the file's subtitle
+  // streams, when `choice` names none of them.
+  SubtitleTrack(const std::string& path, double start_s, const SubtitleStreamChoice& choice = {});
   ~SubtitleTrack();
   SubtitleTrack(const SubtitleTrack&) = delete;
   SubtitleTrack& operator=(const SubtitleTrack&) = delete;

@@ -8,6 +8,7 @@
 #include "hmz_output/signal.hpp"
 #include "hmz_output/video_encoder.hpp"
 #include "inputs/stereo_layout.hpp"
+#include "inputs/subtitle_track.hpp"
 #include "optics/profile.hpp"
 #include "player/input_files.hpp"
 
@@ -17,6 +18,7 @@ namespace nelf {
 struct SubtitleBurn {
   std::string file;               // --sub-file; "" = a subtitle file beside the input, else its own track
   double parallax_percent = 0.0;  // --sub-parallax: of the view width, positive = in front of the screen
+  SubtitleStreamChoice stream;    // --sid, --slang
 };
 
 struct VideoConvertRequest {

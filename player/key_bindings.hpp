@@ -34,6 +34,7 @@ enum class Command {
   next_file,
   previous_file,
   next_audio_track,
+  toggle_subtitles,
   volume_down,
   volume_up,
   mute,

@@ -199,6 +199,16 @@ std::optional<PlayEnd> PlayCommands::apply(Command command) {
       say(what);
       break;
     }
+    case Command::toggle_subtitles:
+      if (!subtitles_shown_) {
+        say("no subtitles");
+        break;
+      }
+      *subtitles_shown_ = !*subtitles_shown_;
+      // The frames decoded ahead were drawn as it was: decoded again from the one on screen.
+      seek_to(position(), "");
+      say(*subtitles_shown_ ? "subtitles on" : "subtitles off");
+      break;
     case Command::help: {
       // Each press shows the next line on screen; the first also prints them all.
       const std::vector<std::string> lines = key_help(KeyScope::play, options_.key_rebindings);

@@ -3,6 +3,7 @@
 // seek (with the time line and seek bar), the screen's distance and the IPD, swapping the eyes, the
 // calibration grid, fullscreen, volume, mute, the audio track and the key help, each with its
 // on-screen message. The play loop reads the state they leave.
+#include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <memory>
@@ -41,7 +42,7 @@ class PlayCommands {
  public:
   PlayCommands(PlayState& state, Display& display, FrameCompositor& compositor, FrameQueue& queue, PlaySound& sound,
                FrameScheduler& scheduler, const PlayerOptions& options, std::optional<double> duration_s,
-               ViewGeometry view, bool still)
+               ViewGeometry view, bool still, std::atomic<bool>* subtitles_shown = nullptr)
       : state_(state),
         display_(display),
         compositor_(compositor),
@@ -51,7 +52,8 @@ class PlayCommands {
         options_(options),
         duration_s_(duration_s),
         view_(view),
-        still_(still) {}
+        still_(still),
+        subtitles_shown_(subtitles_shown) {}
 
   // Carries out `command`; why play ends now, if it does (quit, another file of the playlist).
   std::optional<PlayEnd> apply(Command command);
@@ -93,9 +95,11 @@ class PlayCommands {
   FrameScheduler& scheduler_;
   const PlayerOptions& options_;
   std::optional<double> duration_s_;
-  ViewGeometry view_;          // the source's, for the view format a change of the optics asks for
-  bool still_;                 // a photo: ← and → step through the playlist instead of seeking
-  std::size_t help_line_ = 0;  // the next line of the key help that h shows
+  ViewGeometry view_;  // the source's, for the view format a change of the optics asks for
+  bool still_;
+  std::atomic<bool>* subtitles_shown_;  // read by the decoder as it draws them; null: no subtitles                 // a
+                                        // photo: ← and → step through the playlist instead of seeking
+  std::size_t help_line_ = 0;           // the next line of the key help that h shows
   std::string message_;
   std::chrono::steady_clock::time_point message_until_{};
   std::optional<std::chrono::steady_clock::time_point> progress_until_;

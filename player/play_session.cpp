@@ -16,9 +16,10 @@ namespace {
 
 // The subtitles drawn into each frame on the decode thread: the frame's pts after a seek as before,
 // and the view's compositing untouched (GL, the tables and the frames composited ahead alike).
-std::function<void(StereoVideoFrame&)> subtitle_drawing(const PlayerOptions& options) {
+std::function<void(StereoVideoFrame&)> subtitle_drawing(const PlayerOptions& options, const std::atomic<bool>& shown) {
   if (!options.subtitles) return {};
-  return [track = options.subtitles, parallax = options.sub_parallax_percent](StereoVideoFrame& frame) {
+  return [track = options.subtitles, parallax = options.sub_parallax_percent, &shown](StereoVideoFrame& frame) {
+    if (!shown) return;
     const auto [width, height] = subtitle_canvas(frame);
     draw_subtitles(frame, track->render(frame.pts_s, width, height, frame.aspect), parallax);
   };
@@ -85,8 +86,9 @@ PlaySession::PlaySession(Display& display_, Source& source_, const PlayerOptions
       scheduler(refresh_period, info.frame_rate > 0 && !info.live ? 1.0 / info.frame_rate : 0.0),
       view_format(source.negotiate(compositor.wanted_view_format(info.view))),
       queue(queue_capacity),
-      decoder([this] { decode_loop(source, queue, subtitle_drawing(options)); }),
-      commands(state, display, compositor, queue, sound, scheduler, options, info.duration_s, info.view, info.still),
+      decoder([this] { decode_loop(source, queue, subtitle_drawing(options, subtitles_shown)); }),
+      commands(state, display, compositor, queue, sound, scheduler, options, info.duration_s, info.view, info.still,
+               options.subtitles ? &subtitles_shown : nullptr),
       render_time(refresh_period),
       ticker(refresh_period) {}
 

@@ -10,8 +10,9 @@
 namespace nelf {
 
 std::unique_ptr<SubtitleTrack> choose_subtitles(const std::string& input, const std::string& file, double start_s,
-                                                bool required, bool quiet) {
+                                                bool required, bool quiet, const SubtitleStreamChoice& stream) {
   std::string chosen = file;
+  if (chosen.empty() && stream.any()) chosen = input;
   if (chosen.empty()) {
     const std::vector<std::string> beside = SubtitleTrack::beside(input);
     if (!beside.empty())
@@ -28,11 +29,11 @@ std::unique_ptr<SubtitleTrack> choose_subtitles(const std::string& input, const 
   }
   std::unique_ptr<SubtitleTrack> track;
   try {
-    track = std::make_unique<SubtitleTrack>(chosen, start_s);
+    track = std::make_unique<SubtitleTrack>(chosen, start_s, stream);
   } catch (const UserError& e) {
     // Subtitles found on their own (not named, not asked to be burned in) are no reason to refuse
     // the movie.
-    if (required || !file.empty()) throw;
+    if (required || !file.empty() || stream.any()) throw;
     fmt::print(stderr, "nelf: warning: {}; playing without subtitles\n", printable(e.what()));
     return nullptr;
   }

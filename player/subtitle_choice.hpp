@@ -9,10 +9,11 @@ namespace nelf {
 
 // The subtitles for `input`: `file` (--sub-file) when given, else a subtitle file beside the input
 // (SubtitleTrack::beside), else the input's own first subtitle stream; `start_s` its --start.
-// `required` (--burn-subs): none found throws UserError; otherwise it is null, and subtitles found
-// but not usable are a warning. A `file` that is not usable always throws UserError. Says which
-// track it took unless `quiet`.
+// `stream` (--sid, --slang) picks among the streams of `file`, or of the input itself (the files
+// beside it are then not looked at). `required` (--burn-subs): none found throws UserError;
+// otherwise it is null, and subtitles found but not usable are a warning. A `file` or a `stream`
+// asked for that is not usable always throws UserError. Says which track it took unless `quiet`.
 std::unique_ptr<SubtitleTrack> choose_subtitles(const std::string& input, const std::string& file, double start_s,
-                                                bool required, bool quiet);
+                                                bool required, bool quiet, const SubtitleStreamChoice& stream = {});
 
 }  // namespace nelf

@@ -138,6 +138,43 @@ TEST_F(SubtitlesCli, BadSubtitleInputIsOneLineAndNoOutput) {
   expect_clean_failure(out_, "convert " + q(still) + " " + out + tail + " --burn-subs", 2, "--burn-subs is for video");
 }
 
+// Two subtitle tracks, English then German, with other words: --sid and --slang pick one for
+// convert and play alike, and a track that is not there is one line listing those that are.
+TEST_F(SubtitlesCli, SidAndSlangChooseAmongTheMoviesTracks) {
+  write_file(dir_ / "german.txt", "1\n00:00:00,000 --> 00:00:05,000\nGUTEN TAG WELT, WIE GEHT ES\n\n");
+  make_media(dir_ / "two.mkv", "-i " + q(dir_ / "plain.mp4") + " -f srt -i " + q(dir_ / "lines.txt") + " -f srt -i " +
+                                   q(dir_ / "german.txt") +
+                                   " -map 0 -map 1 -map 2 -c:v copy -c:s srt -metadata:s:s:0 language=eng "
+                                   "-metadata:s:s:1 language=ger");
+  const Packed first = convert(dir_ / "two.mkv", "first.png", "--burn-subs");
+  const Packed english = convert(dir_ / "two.mkv", "english.png", "--burn-subs --sid 1");
+  const Packed second = convert(dir_ / "two.mkv", "second.png", "--burn-subs --sid 2");
+  const Packed german = convert(dir_ / "two.mkv", "german.png", "--burn-subs --slang fra,GER");
+  EXPECT_EQ(first.rgb, english.rgb);
+  EXPECT_EQ(second.rgb, german.rgb);
+  EXPECT_NE(first.rgb, second.rgb);
+  const std::string tail = " --layout sbs --signal sbs --profile " + q(profile_);
+  expect_clean_failure(out_,
+                       "convert " + q(dir_ / "two.mkv") + " " + q(out_ / "out.png") + tail + " --burn-subs --sid 3", 2,
+                       "two.mkv: no subtitle track 3 (--sid): 1: eng, subrip; 2: ger, subrip");
+  expect_clean_failure(out_, "convert " + q(dir_ / "two.mkv") + " " + q(out_ / "out.png") + tail + " --sid 2", 2,
+                       "--sid and --slang choose the track --burn-subs draws");
+  const std::string play_tail = tail + " --output offscreen --no-audio < /dev/null";
+  auto r = run_nelf("play " + q(dir_ / "two.mkv") + " --slang ger" + play_tail);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("nelf: subtitles: " + (dir_ / "two.mkv").string()), std::string::npos) << r.err;
+  r = run_nelf("play " + q(dir_ / "two.mkv") + " --slang fra" + play_tail);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no subtitle track in fra (--slang): 1: eng, subrip; 2: ger, subrip"), std::string::npos)
+      << r.err;
+  r = run_nelf("play " + q(dir_ / "two.mkv") + " --sid x" + play_tail);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--sid x: a track number from 1, auto or no"), std::string::npos) << r.err;
+  r = run_nelf("play " + q(dir_ / "two.mkv") + " --sid no" + play_tail);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("subtitles:"), std::string::npos) << r.err;
+}
+
 // play takes the same track convert burns in, says which, and refuses what convert refuses.
 TEST_F(SubtitlesCli, PlayShowsTheSameTracksAndSaysWhich) {
   const std::string tail = " --layout sbs --profile " + q(profile_) + " --output offscreen --no-audio < /dev/null";

@@ -440,7 +440,7 @@ TEST_F(PlayerTest, NoFrameCompositedAheadShowsAStateAKeyHasChanged) {
     EXPECT_GE(compared[typed], 5) << "too few frames in the same state in both runs after " << typed << " keys";
 }
 
-// Subtitles play drew into the frames as they are decoded: a cue from 0.6 s to 1.4 s of the clip is
+// The subtitles play draws into the frames as they are decoded: a cue from 0.6 s to 1.4 s of the clip is
 // in both eyes' panels while it shows and in neither before or after (the same clip played without
 // it on the stepped clock is the reference). The views arrive as block means here (80x45), so the
 // letters are a few pixels: a small difference counts.
@@ -450,42 +450,54 @@ TEST_F(PlayerTest, ASubtitleCueShowsInBothEyesForItsTimeOnly) {
   PlayerOptions options = silent_options();
   const auto left = *eye_area(options.signal, Eye::left, 160, 90);
   const auto right = *eye_area(options.signal, Eye::right, 160, 90);
-  std::map<double, std::array<Image, 2>> shown[2];  // [0]: no subtitles, [1]: the cue
-  for (int run : {0, 1}) {
+  // [0]: no subtitles, [1]: the cue, [2]: the cue with v typed at the first frame
+  std::map<double, std::array<Image, 2>> shown[3];
+  for (int run : {0, 1, 2}) {
     options.clock = std::make_shared<playback::SteppedClock>();
-    options.subtitles = run == 1 ? std::make_shared<SubtitleTrack>((dir_ / "cue.srt").string(), 0.0) : nullptr;
-    auto display = open_display(options);
+    options.subtitles = run > 0 ? std::make_shared<SubtitleTrack>((dir_ / "cue.srt").string(), 0.0) : nullptr;
+    options.on_screen_messages = run != 2;  // "subtitles off" would be over the frames compared
+    TypedKeysDisplay display(open_display(options));
+    bool typed = false;
     options.after_render = [&](const Display& d, double pts) {
       const auto panel = [&](const EyeArea& a) {
         return read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90);
       };
       shown[run][pts] = {panel(left), panel(right)};
+      if (run == 2 && !typed) {
+        display.type(KeyPress::of(U'v'));
+        typed = true;
+      }
     };
     auto source = test::open_input(clip);
-    EXPECT_EQ(play(*display, *source, options).end, PlayEnd::end_of_file);
+    EXPECT_EQ(play(display, *source, options).end, PlayEnd::end_of_file);
   }
-  int during = 0, outside = 0;
-  for (const auto& [pts, eyes] : shown[1]) {
-    if (!shown[0].count(pts) || std::abs(pts - 0.6) < 0.05 || std::abs(pts - 1.4) < 0.05) continue;
-    const bool showing = pts > 0.6 && pts < 1.4;
-    for (int e : {0, 1}) {
-      const Image& with = eyes[static_cast<std::size_t>(e)];
-      const Image& without = shown[0][pts][static_cast<std::size_t>(e)];
-      int changed = 0;
-      for (std::size_t i = 0; i < std::size_t{160} * 90; ++i) {
-        const float* a = &with.data()[i * 4];
-        const float* b = &without.data()[i * 4];
-        if (std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]) > 0.05f) ++changed;
+  int during = 0, outside = 0, hidden = 0;
+  for (int run : {1, 2})
+    for (const auto& [pts, eyes] : shown[run]) {
+      if (!shown[0].count(pts) || std::abs(pts - 0.6) < 0.05 || std::abs(pts - 1.4) < 0.05) continue;
+      const bool showing = run == 1 && pts > 0.6 && pts < 1.4;
+      for (int e : {0, 1}) {
+        const Image& with = eyes[static_cast<std::size_t>(e)];
+        const Image& without = shown[0][pts][static_cast<std::size_t>(e)];
+        int changed = 0;
+        for (std::size_t i = 0; i < std::size_t{160} * 90; ++i) {
+          const float* a = &with.data()[i * 4];
+          const float* b = &without.data()[i * 4];
+          if (std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]) > 0.05f) ++changed;
+        }
+        if (showing)
+          EXPECT_GT(changed, 20) << "no subtitle at " << pts << " s in eye " << e;
+        else
+          EXPECT_EQ(changed, 0) << "a subtitle at " << pts << " s in eye " << e;
       }
-      if (showing)
-        EXPECT_GT(changed, 20) << "no subtitle at " << pts << " s in eye " << e;
+      if (run == 2)
+        ++hidden;
       else
-        EXPECT_EQ(changed, 0) << "a subtitle at " << pts << " s in eye " << e;
+        ++(showing ? during : outside);
     }
-    ++(showing ? during : outside);
-  }
   EXPECT_GE(during, 15);
   EXPECT_GE(outside, 20);
+  EXPECT_GE(hidden, 40);  // v at the first frame: none of the cue's frames shows it
 }
 
 // On the tests' stepped clock the play loop's decisions follow from the timestamps and the refresh
