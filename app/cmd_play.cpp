@@ -118,9 +118,15 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
                    clock_time(*record.position_s));
     }
   }
-  if (!info.still) {
+  if (!info.still && subtitles) {
     options.subtitles = std::move(subtitles);
     options.sub_parallax_percent = parse_sub_parallax(args.sub_parallax);
+    if (!args.sub_parallax && record.sub_parallax && std::abs(*record.sub_parallax) <= 10) {
+      options.sub_parallax_percent = *record.sub_parallax;
+      if (!args.quiet)
+        fmt::print(stderr, "nelf: subtitle depth {:g} % as last time (--sub-parallax overrides)\n",
+                   *record.sub_parallax);
+    }
   }
   if (options.start_s && !info.seekable)
     throw UserError(
@@ -143,6 +149,10 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
     if (swapped || record.swap_eyes) left.swap_eyes = swapped;
     // A pair's second file is given each time (--right): only a one-file layout is remembered.
     if (common.layout && *common.layout != StereoLayout::pair) left.layout = args.layout;
+    // The depth the subtitles were left at, when it is not the default (given or set by keys).
+    if (result.sub_parallax_percent)
+      left.sub_parallax =
+          *result.sub_parallax_percent != 0 ? std::optional<double>(*result.sub_parallax_percent) : std::nullopt;
     watch_later.save(*key, left, warn);
   }
   return result;

@@ -35,6 +35,8 @@ enum class Command {
   previous_file,
   next_audio_track,
   toggle_subtitles,
+  subtitles_nearer,
+  subtitles_farther,
   volume_down,
   volume_up,
   mute,

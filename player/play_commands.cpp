@@ -200,15 +200,31 @@ std::optional<PlayEnd> PlayCommands::apply(Command command) {
       break;
     }
     case Command::toggle_subtitles:
-      if (!subtitles_shown_) {
+      if (!subtitles_) {
         say("no subtitles");
         break;
       }
-      *subtitles_shown_ = !*subtitles_shown_;
+      subtitles_->shown = !subtitles_->shown;
       // The frames decoded ahead were drawn as it was: decoded again from the one on screen.
       seek_to(position(), "");
-      say(*subtitles_shown_ ? "subtitles on" : "subtitles off");
+      say(subtitles_->shown ? "subtitles on" : "subtitles off");
       break;
+    case Command::subtitles_nearer:
+    case Command::subtitles_farther: {
+      if (!subtitles_) {
+        say("no subtitles");
+        break;
+      }
+      // --sub-parallax's range: beyond it the two copies no longer fuse.
+      const double step = command == Command::subtitles_nearer ? 0.25 : -0.25;
+      subtitles_->parallax_percent = std::clamp(subtitles_->parallax_percent + step, -10.0, 10.0);
+      seek_to(position(), "");
+      say(fmt::format("subtitle depth {:+.2f} % ({})", subtitles_->parallax_percent.load(),
+                      subtitles_->parallax_percent > 0   ? "in front of the screen"
+                      : subtitles_->parallax_percent < 0 ? "behind the screen"
+                                                         : "on the screen"));
+      break;
+    }
     case Command::help: {
       // Each press shows the next line on screen; the first also prints them all.
       const std::vector<std::string> lines = key_help(KeyScope::play, options_.key_rebindings);

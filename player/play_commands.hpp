@@ -26,6 +26,14 @@ namespace nelf::playback {
 // The calibration grid (key c): calibrate's grid pattern at the views' size and the optics.
 FrameCompositor::GridPattern calibration_grid_pattern();
 
+// What the decoder reads as it draws the subtitles into each frame, and the keys change: whether
+// they show (v) and their depth (r R), in percent of the view width.
+struct SubtitleControls {
+  explicit SubtitleControls(double parallax) : parallax_percent(parallax) {}
+  std::atomic<bool> shown{true};
+  std::atomic<double> parallax_percent;
+};
+
 struct PlayState {
   bool paused = false;
   bool started = false;  // the first frame is on screen (the clock waits for it)
@@ -42,7 +50,7 @@ class PlayCommands {
  public:
   PlayCommands(PlayState& state, Display& display, FrameCompositor& compositor, FrameQueue& queue, PlaySound& sound,
                FrameScheduler& scheduler, const PlayerOptions& options, std::optional<double> duration_s,
-               ViewGeometry view, bool still, std::atomic<bool>* subtitles_shown = nullptr)
+               ViewGeometry view, bool still, SubtitleControls* subtitles = nullptr)
       : state_(state),
         display_(display),
         compositor_(compositor),
@@ -53,7 +61,7 @@ class PlayCommands {
         duration_s_(duration_s),
         view_(view),
         still_(still),
-        subtitles_shown_(subtitles_shown) {}
+        subtitles_(subtitles) {}
 
   // Carries out `command`; why play ends now, if it does (quit, another file of the playlist).
   std::optional<PlayEnd> apply(Command command);
@@ -97,9 +105,9 @@ class PlayCommands {
   std::optional<double> duration_s_;
   ViewGeometry view_;  // the source's, for the view format a change of the optics asks for
   bool still_;
-  std::atomic<bool>* subtitles_shown_;  // read by the decoder as it draws them; null: no subtitles                 // a
-                                        // photo: ← and → step through the playlist instead of seeking
-  std::size_t help_line_ = 0;           // the next line of the key help that h shows
+  SubtitleControls* subtitles_;  // read by the decoder as it draws them; null: no subtitles                 // a
+                                 // photo: ← and → step through the playlist instead of seeking
+  std::size_t help_line_ = 0;    // the next line of the key help that h shows
   std::string message_;
   std::chrono::steady_clock::time_point message_until_{};
   std::optional<std::chrono::steady_clock::time_point> progress_until_;

@@ -16,10 +16,12 @@ namespace {
 
 // The subtitles drawn into each frame on the decode thread: the frame's pts after a seek as before,
 // and the view's compositing untouched (GL, the tables and the frames composited ahead alike).
-std::function<void(StereoVideoFrame&)> subtitle_drawing(const PlayerOptions& options, const std::atomic<bool>& shown) {
+std::function<void(StereoVideoFrame&)> subtitle_drawing(const PlayerOptions& options,
+                                                        const SubtitleControls& controls) {
   if (!options.subtitles) return {};
-  return [track = options.subtitles, parallax = options.sub_parallax_percent, &shown](StereoVideoFrame& frame) {
-    if (!shown) return;
+  return [track = options.subtitles, &controls](StereoVideoFrame& frame) {
+    if (!controls.shown) return;
+    const double parallax = controls.parallax_percent;
     const auto [width, height] = subtitle_canvas(frame);
     draw_subtitles(frame, track->render(frame.pts_s, width, height, frame.aspect), parallax);
   };
@@ -86,9 +88,9 @@ PlaySession::PlaySession(Display& display_, Source& source_, const PlayerOptions
       scheduler(refresh_period, info.frame_rate > 0 && !info.live ? 1.0 / info.frame_rate : 0.0),
       view_format(source.negotiate(compositor.wanted_view_format(info.view))),
       queue(queue_capacity),
-      decoder([this] { decode_loop(source, queue, subtitle_drawing(options, subtitles_shown)); }),
+      decoder([this] { decode_loop(source, queue, subtitle_drawing(options, subtitles)); }),
       commands(state, display, compositor, queue, sound, scheduler, options, info.duration_s, info.view, info.still,
-               options.subtitles ? &subtitles_shown : nullptr),
+               options.subtitles ? &subtitles : nullptr),
       render_time(refresh_period),
       ticker(refresh_period) {}
 
@@ -161,6 +163,7 @@ PlayResult PlaySession::finish(std::int64_t composited_ahead) {
   else if (state.current)
     result.position_s = state.current->pts_s;
   result.eyes_swapped = state.swap_eyes;
+  if (options.subtitles) result.sub_parallax_percent = subtitles.parallax_percent;
   return result;
 }
 

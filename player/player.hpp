@@ -85,7 +85,8 @@ struct PlayResult {
   // Where play stopped, in the movie's time (the target of a seek not yet shown); none when nothing
   // was shown.
   std::optional<double> position_s;
-  bool eyes_swapped = false;  // the user swapped the eyes (key s) an odd number of times
+  bool eyes_swapped = false;                   // the user swapped the eyes (key s) an odd number of times
+  std::optional<double> sub_parallax_percent;  // the subtitles' depth at the end (there were some)
 };
 
 // Plays `source` on `display` until the end of the file, q/Esc, the window closing or `*stop`

@@ -13,9 +13,10 @@
 namespace nelf {
 
 struct WatchLaterRecord {
-  std::optional<double> position_s;   // where play stopped, in the movie's time
-  std::optional<bool> swap_eyes;      // the eyes as the user last had them
-  std::optional<std::string> layout;  // --layout as last given
+  std::optional<double> position_s;    // where play stopped, in the movie's time
+  std::optional<bool> swap_eyes;       // the eyes as the user last had them
+  std::optional<std::string> layout;   // --layout as last given
+  std::optional<double> sub_parallax;  // the subtitles' depth (--sub-parallax, keys r R) as last left
 
   // Each field with its key in the file: a new field is a member and one line here.
   template <class Visit>
@@ -23,6 +24,7 @@ struct WatchLaterRecord {
     visit("position", &WatchLaterRecord::position_s);
     visit("swap_eyes", &WatchLaterRecord::swap_eyes);
     visit("layout", &WatchLaterRecord::layout);
+    visit("sub_parallax", &WatchLaterRecord::sub_parallax);
   }
   bool empty() const;
 };

@@ -175,6 +175,37 @@ TEST_F(SubtitlesCli, SidAndSlangChooseAmongTheMoviesTracks) {
   EXPECT_EQ(r.err.find("subtitles:"), std::string::npos) << r.err;
 }
 
+// R and r move the subtitles while playing; the depth they were left at is the file's next time
+// (said in one line), until --sub-parallax says otherwise.
+TEST_F(SubtitlesCli, PlayRemembersTheDepthTheKeysLeft) {
+  std::filesystem::copy_file(dir_ / "plain.mp4", dir_ / "movie.mp4");
+  write_file(dir_ / "movie.srt", kSrt);
+  const auto state = dir_ / "state";
+  const auto play = [&](const std::string& args, const std::string& keys) {
+    write_file(dir_ / "keys", keys);
+    return run_command("timeout 120 env -u DISPLAY XDG_STATE_HOME=" + q(state) + " " + NELF_BINARY + " play " +
+                       q(dir_ / "movie.mp4") + " --layout sbs --profile " + q(profile_) +
+                       " --output offscreen --no-audio " + args + " < " + q(dir_ / "keys"));
+  };
+  const auto record = [&] {
+    std::string text;
+    for (const auto& entry : std::filesystem::directory_iterator(state / "nelf" / "watch_later"))
+      text += read_file(entry.path());
+    return text;
+  };
+  auto r = play("", "RRRrq");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(record().find("sub_parallax = 0.5"), std::string::npos) << record();
+  r = play("", "q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("nelf: subtitle depth 0.5 % as last time (--sub-parallax overrides)"), std::string::npos)
+      << r.err;
+  r = play("--sub-parallax 0 --no-resume", "q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("as last time"), std::string::npos) << r.err;
+  EXPECT_EQ(record().find("sub_parallax"), std::string::npos) << record();
+}
+
 // play takes the same track convert burns in, says which, and refuses what convert refuses.
 TEST_F(SubtitlesCli, PlayShowsTheSameTracksAndSaysWhich) {
   const std::string tail = " --layout sbs --profile " + q(profile_) + " --output offscreen --no-audio < /dev/null";

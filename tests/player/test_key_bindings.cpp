@@ -34,8 +34,9 @@ TEST(KeyBindings, KeysMeanWhatTheHelpSays) {
   EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U'=')), Command::screen_farther);
   EXPECT_EQ(command_for(KeyScope::calibrate, KeyPress::of(KeyPress::Named::left)), Command::shift_left);
   EXPECT_EQ(command_for(KeyScope::calibrate, KeyPress::of(U'R')), Command::rotate_more);
-  EXPECT_EQ(command_for(KeyScope::calibrate, KeyPress::of(U's')), std::nullopt);  // play's, not calibrate's
-  EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U'r')), std::nullopt);
+  EXPECT_EQ(command_for(KeyScope::calibrate, KeyPress::of(U's')), std::nullopt);           // play's, not calibrate's
+  EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U'r')), Command::subtitles_farther);  // calibrate's R rotates
+  EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U'k')), std::nullopt);
   // --defects: d and s mark (calibrate's d is the prescription), arrows move the cursor.
   EXPECT_EQ(command_for(KeyScope::defects, KeyPress::of(U'd')), Command::mark_dead);
   EXPECT_EQ(command_for(KeyScope::calibrate, KeyPress::of(U'd')), Command::prescription_less);
