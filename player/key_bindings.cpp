@@ -11,6 +11,11 @@ namespace {
 using N = KeyPress::Named;
 KeyPress named(N n) { return KeyPress::of(n); }
 KeyPress ch(char32_t c) { return KeyPress::of(c); }
+KeyPress ctrl(char32_t c) {
+  KeyPress k = KeyPress::of(c);
+  k.ctrl = true;
+  return k;
+}
 
 }  // namespace
 
@@ -84,6 +89,13 @@ const std::vector<KeyBinding>& key_bindings() {
        "v",
        "subtitles on / off",
        "(`--no-subs` starts with none)",
+       ""},
+      {S::play,
+       {{ctrl(U's'), C::screenshot}},
+       "Ctrl+s",
+       "Ctrl+s",
+       "screenshot of the packed frame as the display shows it",
+       "(`nelf-shot0001.png`, … in the current folder; mpv's Ctrl+s)",
        ""},
       {S::play,
        {{ch(U'R'), C::subtitles_nearer}, {ch(U'r'), C::subtitles_farther}},
@@ -260,7 +272,7 @@ const std::vector<KeyBinding>& key_bindings() {
 namespace {
 
 bool matches(const KeyPress& press, const KeyPress& key) {
-  return press.named != N::none ? key.is(press.named) : (!key.ctrl && !key.alt && key.is(press.character));
+  return press.named != N::none ? key.is(press.named) : (key.ctrl == press.ctrl && !key.alt && key.is(press.character));
 }
 
 const KeyRebinding* rebinding_of(const KeyPress& press, const KeyRebindings& rebindings) {
@@ -298,6 +310,7 @@ constexpr NamedCommand play_commands[] = {
     {Command::toggle_subtitles, "toggle-subtitles"},
     {Command::subtitles_nearer, "subtitles-nearer"},
     {Command::subtitles_farther, "subtitles-farther"},
+    {Command::screenshot, "screenshot"},
     {Command::help, "help"},
     {Command::quit, "quit"},
 };
@@ -468,7 +481,7 @@ std::optional<KeyPress> parse_key_name(std::string_view name) {
 }
 
 std::string key_name(const KeyPress& key) {
-  if (key.named == N::none) return utf8(key.character);
+  if (key.named == N::none) return (key.ctrl ? "Ctrl+" : "") + utf8(key.character);
   for (const NamedKey& k : named_keys)
     if (k.key == key.named) return std::string(k.shown);
   return "?";

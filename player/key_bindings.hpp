@@ -37,6 +37,7 @@ enum class Command {
   toggle_subtitles,
   subtitles_nearer,
   subtitles_farther,
+  screenshot,
   volume_down,
   volume_up,
   mute,

@@ -4,9 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <vector>
 
 #include "compositor/gl/gl_compositor.hpp"
+#include "core/printable.hpp"
+#include "hmz_output/image_sink.hpp"
 #include "inputs/test_patterns.hpp"
 
 namespace nelf::playback {
@@ -110,6 +114,28 @@ void PlayCommands::change_profile(const Profile& changed, const std::string& wha
   }
 }
 
+void PlayCommands::take_pending_screenshot() {
+  if (screenshots_pending_ == 0 || !state_.current) return;  // nothing drawn yet: the next refresh
+  --screenshots_pending_;
+  try {
+    std::filesystem::path path;
+    std::error_code error;
+    for (int n = 1; n <= 9999 && path.empty(); ++n) {
+      std::filesystem::path candidate = fmt::format("nelf-shot{:04d}.png", n);
+      if (!std::filesystem::exists(candidate, error) && !error) path = std::move(candidate);
+    }
+    if (path.empty()) throw ImageWriteError("nelf-shot0001.png to nelf-shot9999.png are all taken");
+    const auto [width, height] = display_.packed_size();
+    // As the display shows it: the frame with its messages, the grid, the eyes as swapped.
+    write_image_file(read_back(display_.packed_framebuffer(), 0, 0, width, height), path, {});
+    if (!options_.quiet) fmt::print(stderr, "nelf: screenshot {}\n", printable(path.string()));
+    say(fmt::format("screenshot {}", path.string()));
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "nelf: warning: no screenshot: {}\n", printable(e.what()));
+    say(fmt::format("no screenshot: {}", e.what()));
+  }
+}
+
 std::optional<PlayEnd> PlayCommands::apply(Command command) {
   switch (command) {
     case Command::quit:
@@ -199,6 +225,9 @@ std::optional<PlayEnd> PlayCommands::apply(Command command) {
       say(what);
       break;
     }
+    case Command::screenshot:
+      ++screenshots_pending_;
+      break;
     case Command::toggle_subtitles:
       if (!subtitles_) {
         say("no subtitles");

@@ -79,6 +79,9 @@ class PlayCommands {
   void set_mute(bool mute) {
     if (mute != sound_.muted()) say(sound_.toggle_mute());
   }
+  // A screenshot asked for (Ctrl+s) is taken once a frame is on the display: the packed frame
+  // into the first free nelf-shotNNNN.png of the current folder. Called after each refresh's render.
+  void take_pending_screenshot();
   // A message on screen for two seconds (when on-screen messages are on); the frame is redrawn.
   void say(std::string text);
   // Takes the message off the screen once its two seconds are up.
@@ -105,7 +108,8 @@ class PlayCommands {
   std::optional<double> duration_s_;
   ViewGeometry view_;  // the source's, for the view format a change of the optics asks for
   bool still_;
-  SubtitleControls* subtitles_;  // read by the decoder as it draws them; null: no subtitles                 // a
+  SubtitleControls* subtitles_;
+  int screenshots_pending_ = 0;  // read by the decoder as it draws them; null: no subtitles                 // a
                                  // photo: ← and → step through the playlist instead of seeking
   std::size_t help_line_ = 0;    // the next line of the key help that h shows
   std::string message_;

@@ -61,6 +61,7 @@ Refresh choose_frame(PlaySession& s) {
 void present_frame(PlaySession& s, Refresh& r) {
   PlayState& state = s.state;
   if (!state.dirty) {
+    s.commands.take_pending_screenshot();        // the frame the display keeps showing
     if (s.display.vsync()) s.display.present();  // paces the loop at the refresh
     return;
   }
@@ -69,6 +70,7 @@ void present_frame(PlaySession& s, Refresh& r) {
   if (s.log.enabled()) glFinish();
   r.render_s = seconds_since(t);
   if (s.options.after_render) s.options.after_render(s.display, state.current ? state.current->pts_s : 0.0);
+  s.commands.take_pending_screenshot();
   t = Steady::now();
   try {
     s.display.present();

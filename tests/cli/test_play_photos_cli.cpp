@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -220,6 +221,37 @@ TEST_F(PlayPhotos, PlayResumesWhereItWasStoppedAndRemembersTheSetUp) {
   EXPECT_NE(r.err.find("the saved state of " + fs::canonical(c).string() + " is damaged"), std::string::npos) << r.err;
   EXPECT_NEAR(first_shown_pts(log), 0.0, 1e-3);
   EXPECT_EQ(read_file(other_record), other_text);
+}
+
+// Ctrl+s writes the packed frame as the display shows it, into the current folder under the first
+// free name: the picture convert writes of the same photo, the right way up.
+TEST_F(PlayPhotos, CtrlSWritesThePackedFrameAsConvertDoes) {
+  const fs::path chart = write_lavfi_still(dir_, "chart.png", "testsrc2=s=256x72");
+  const fs::path shots = dir_ / "shots";
+  fs::create_directories(shots);
+  write_file(dir_ / "keys", "\x13\x13q");
+  const auto r =
+      run_command("cd " + q(shots) + " && timeout 120 env -u DISPLAY LP_NUM_THREADS=2 XDG_STATE_HOME=" + q(state_) +
+                  " " + NELF_BINARY + " play " + q(chart) + " --layout sbs --profile " + q(profile_) +
+                  " --output offscreen --no-audio < " + q(dir_ / "keys"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(in_order(r.err, {"nelf: screenshot nelf-shot0001.png", "nelf: screenshot nelf-shot0002.png"})) << r.err;
+  const auto converted = run_nelf("convert " + q(chart) + " " + q(dir_ / "converted.png") + " --layout sbs --profile " +
+                                  q(profile_) + " --quiet");
+  ASSERT_EQ(converted.status, 0) << converted.err;
+  const ReadBack shot = read_back(shots / "nelf-shot0001.png"), want = read_back(dir_ / "converted.png");
+  ASSERT_EQ(shot.width, want.width);
+  ASSERT_EQ(shot.height, want.height);
+  double same = 0, flipped = 0;
+  for (int y = 0; y < shot.height; ++y)
+    for (int x = 0; x < shot.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        same += std::abs(shot.at(x, y, c) - want.at(x, y, c));
+        flipped += std::abs(shot.at(x, y, c) - want.at(x, shot.height - 1 - y, c));
+      }
+  const double n = 3.0 * shot.width * shot.height;
+  EXPECT_LT(same / n, 0.01);
+  EXPECT_GT(flipped / n, 50 * same / n + 0.001);  // the panels are mostly black: small means
 }
 
 // An MPO (two JPEGs) and a JPS (right view first) read alike in probe and play: probe used to see

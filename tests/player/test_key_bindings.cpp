@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include "player/calibration_controls.hpp"
 #include "player/defect_marking.hpp"
@@ -17,12 +18,12 @@ namespace {
 
 TEST(KeyBindings, NoKeyMeansTwoThingsInOneScope) {
   for (const KeyScope scope : {KeyScope::play, KeyScope::calibrate, KeyScope::defects}) {
-    std::set<std::pair<int, char32_t>> seen;
+    std::set<std::tuple<int, char32_t, bool>> seen;
     for (const KeyBinding& row : key_bindings()) {
       if (row.scope != scope) continue;
       EXPECT_FALSE(row.keys.empty()) << row.label;
       for (const auto& [press, command] : row.keys)
-        EXPECT_TRUE(seen.insert({static_cast<int>(press.named), press.character}).second) << row.label;
+        EXPECT_TRUE(seen.insert({static_cast<int>(press.named), press.character, press.ctrl}).second) << row.label;
     }
   }
 }
@@ -37,6 +38,10 @@ TEST(KeyBindings, KeysMeanWhatTheHelpSays) {
   EXPECT_EQ(command_for(KeyScope::calibrate, KeyPress::of(U's')), std::nullopt);           // play's, not calibrate's
   EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U'r')), Command::subtitles_farther);  // calibrate's R rotates
   EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U'k')), std::nullopt);
+  KeyPress ctrl_s = KeyPress::of(U's');
+  ctrl_s.ctrl = true;
+  EXPECT_EQ(command_for(KeyScope::play, ctrl_s), Command::screenshot);
+  EXPECT_EQ(command_for(KeyScope::play, KeyPress::of(U's')), Command::swap_eyes);
   // --defects: d and s mark (calibrate's d is the prescription), arrows move the cursor.
   EXPECT_EQ(command_for(KeyScope::defects, KeyPress::of(U'd')), Command::mark_dead);
   EXPECT_EQ(command_for(KeyScope::calibrate, KeyPress::of(U'd')), Command::prescription_less);
