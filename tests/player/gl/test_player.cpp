@@ -40,6 +40,34 @@ using test::make_clip;
 using test::Mean;
 using test::mean_of;
 
+// A display with keys the test types itself: they come with the player's next poll, so the frame
+// rendered after the one a key was typed at is the first one the key may change.
+class TypedKeysDisplay final : public Display {
+ public:
+  explicit TypedKeysDisplay(std::unique_ptr<Display> inner) : inner_(std::move(inner)) {}
+  void type(KeyPress key) { typed_.push_back(key); }
+
+  std::shared_ptr<gl::Context> context() const override { return inner_->context(); }
+  GLuint packed_framebuffer() const override { return inner_->packed_framebuffer(); }
+  GLuint packed_texture() const override { return inner_->packed_texture(); }
+  std::array<int, 2> packed_size() const override { return inner_->packed_size(); }
+  void present() override { inner_->present(); }
+  double refresh_hz() const override { return inner_->refresh_hz(); }
+  bool vsync() const override { return inner_->vsync(); }
+  std::vector<KeyPress> poll_events() override {
+    std::vector<KeyPress> keys = inner_->poll_events();
+    keys.insert(keys.end(), typed_.begin(), typed_.end());
+    typed_.clear();
+    return keys;
+  }
+  bool close_requested() const override { return inner_->close_requested(); }
+  std::string description() const override { return inner_->description(); }
+
+ private:
+  std::unique_ptr<Display> inner_;
+  std::vector<KeyPress> typed_;
+};
+
 class PlayerTest : public ::testing::Test {
  protected:
   test::TempDir dir_;
@@ -48,6 +76,36 @@ class PlayerTest : public ::testing::Test {
   // The offscreen output showing the packed frame of `options`' 160x90 panel.
   static std::unique_ptr<Display> open_display(const PlayerOptions& options) {
     return display_driver("offscreen").open_display(test::small_panel_display_options(options));
+  }
+  // Both eyes' panels of every frame `options` plays of `clip` on a stepped clock, by pts, with
+  // `key` (if any) typed at the first frame.
+  std::map<double, std::array<Image, 2>> panels_played(const std::filesystem::path& clip, PlayerOptions options,
+                                                       std::optional<KeyPress> key = std::nullopt) const {
+    const auto left = *eye_area(options.signal, Eye::left, 160, 90);
+    const auto right = *eye_area(options.signal, Eye::right, 160, 90);
+    std::map<double, std::array<Image, 2>> shown;
+    options.clock = std::make_shared<playback::SteppedClock>();
+    TypedKeysDisplay display(open_display(options));
+    options.after_render = [&](const Display& d, double pts) {
+      const auto panel = [&](const EyeArea& a) {
+        return read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90);
+      };
+      shown[pts] = {panel(left), panel(right)};
+      if (key) display.type(*std::exchange(key, std::nullopt));
+    };
+    auto source = test::open_input(clip);
+    EXPECT_EQ(play(display, *source, options).end, PlayEnd::end_of_file);
+    return shown;
+  }
+  // How many pixels of two 160x90 panels differ by more than `threshold` (summed over R, G, B).
+  static int differing(const Image& a, const Image& b, float threshold) {
+    int changed = 0;
+    for (std::size_t i = 0; i < std::size_t{160} * 90; ++i) {
+      const float* p = &a.data()[i * 4];
+      const float* q = &b.data()[i * 4];
+      if (std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) + std::abs(p[2] - q[2]) > threshold) ++changed;
+    }
+    return changed;
   }
 };
 
@@ -210,34 +268,6 @@ class ScopedEnv {
  private:
   std::string name_;
   std::optional<std::string> old_;
-};
-
-// A display with keys the test types itself: they come with the player's next poll, so the frame
-// rendered after the one a key was typed at is the first one the key may change.
-class TypedKeysDisplay final : public Display {
- public:
-  explicit TypedKeysDisplay(std::unique_ptr<Display> inner) : inner_(std::move(inner)) {}
-  void type(KeyPress key) { typed_.push_back(key); }
-
-  std::shared_ptr<gl::Context> context() const override { return inner_->context(); }
-  GLuint packed_framebuffer() const override { return inner_->packed_framebuffer(); }
-  GLuint packed_texture() const override { return inner_->packed_texture(); }
-  std::array<int, 2> packed_size() const override { return inner_->packed_size(); }
-  void present() override { inner_->present(); }
-  double refresh_hz() const override { return inner_->refresh_hz(); }
-  bool vsync() const override { return inner_->vsync(); }
-  std::vector<KeyPress> poll_events() override {
-    std::vector<KeyPress> keys = inner_->poll_events();
-    keys.insert(keys.end(), typed_.begin(), typed_.end());
-    typed_.clear();
-    return keys;
-  }
-  bool close_requested() const override { return inner_->close_requested(); }
-  std::string description() const override { return inner_->description(); }
-
- private:
-  std::unique_ptr<Display> inner_;
-  std::vector<KeyPress> typed_;
 };
 
 TEST_F(PlayerTest, TheCompositeTableShowsWhatTheGlCompositorShowsAndMessagesStillShow) {
@@ -448,49 +478,25 @@ TEST_F(PlayerTest, ASubtitleCueShowsInBothEyesForItsTimeOnly) {
   const auto clip = make_clip(dir_, 2);
   test::write_file(dir_ / "cue.srt", "1\n00:00:00,600 --> 00:00:01,400\nHELLO 3D WORLD\n\n");
   PlayerOptions options = silent_options();
-  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
-  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
-  // [0]: no subtitles, [1]: the cue, [2]: the cue with v typed at the first frame
-  std::map<double, std::array<Image, 2>> shown[3];
-  for (int run : {0, 1, 2}) {
-    options.clock = std::make_shared<playback::SteppedClock>();
-    options.subtitles = run > 0 ? std::make_shared<SubtitleTrack>((dir_ / "cue.srt").string(), 0.0) : nullptr;
-    options.on_screen_messages = run != 2;  // "subtitles off" would be over the frames compared
-    TypedKeysDisplay display(open_display(options));
-    bool typed = false;
-    options.after_render = [&](const Display& d, double pts) {
-      const auto panel = [&](const EyeArea& a) {
-        return read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90);
-      };
-      shown[run][pts] = {panel(left), panel(right)};
-      if (run == 2 && !typed) {
-        display.type(KeyPress::of(U'v'));
-        typed = true;
-      }
-    };
-    auto source = test::open_input(clip);
-    EXPECT_EQ(play(display, *source, options).end, PlayEnd::end_of_file);
-  }
+  const auto without = panels_played(clip, options);
+  options.subtitles = std::make_shared<SubtitleTrack>((dir_ / "cue.srt").string(), 0.0);
+  const auto with = panels_played(clip, options);
+  options.subtitles = std::make_shared<SubtitleTrack>((dir_ / "cue.srt").string(), 0.0);
+  options.on_screen_messages = false;  // "subtitles off" would be over the frames compared
+  const auto hidden_by_v = panels_played(clip, options, KeyPress::of(U'v'));
   int during = 0, outside = 0, hidden = 0;
-  for (int run : {1, 2})
-    for (const auto& [pts, eyes] : shown[run]) {
-      if (!shown[0].count(pts) || std::abs(pts - 0.6) < 0.05 || std::abs(pts - 1.4) < 0.05) continue;
-      const bool showing = run == 1 && pts > 0.6 && pts < 1.4;
-      for (int e : {0, 1}) {
-        const Image& with = eyes[static_cast<std::size_t>(e)];
-        const Image& without = shown[0][pts][static_cast<std::size_t>(e)];
-        int changed = 0;
-        for (std::size_t i = 0; i < std::size_t{160} * 90; ++i) {
-          const float* a = &with.data()[i * 4];
-          const float* b = &without.data()[i * 4];
-          if (std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]) > 0.05f) ++changed;
-        }
+  for (const auto* run : {&with, &hidden_by_v})
+    for (const auto& [pts, eyes] : *run) {
+      if (!without.count(pts) || std::abs(pts - 0.6) < 0.05 || std::abs(pts - 1.4) < 0.05) continue;
+      const bool showing = run == &with && pts > 0.6 && pts < 1.4;
+      for (std::size_t e : {0u, 1u}) {
+        const int changed = differing(eyes[e], without.at(pts)[e], 0.05f);
         if (showing)
           EXPECT_GT(changed, 20) << "no subtitle at " << pts << " s in eye " << e;
         else
           EXPECT_EQ(changed, 0) << "a subtitle at " << pts << " s in eye " << e;
       }
-      if (run == 2)
+      if (run == &hidden_by_v)
         ++hidden;
       else
         ++(showing ? during : outside);
@@ -508,42 +514,14 @@ TEST_F(PlayerTest, ASubtitleCueShowsInBothEyesForItsTimeOnly) {
 // differs, in both eyes' panels, at every frame from half a second on.
 TEST_F(PlayerTest, KeyOShowsTheTimeLineAndSeekBarInBothEyes) {
   const auto clip = make_clip(dir_, 2);
-  PlayerOptions options = silent_options();
-  const auto left = *eye_area(options.signal, Eye::left, 160, 90);
-  const auto right = *eye_area(options.signal, Eye::right, 160, 90);
-  std::map<double, std::array<Image, 2>> shown[2];  // [0]: no key, [1]: O typed at the first frame
-  for (int run : {0, 1}) {
-    options.clock = std::make_shared<playback::SteppedClock>();
-    TypedKeysDisplay display(open_display(options));
-    bool typed = false;
-    options.after_render = [&](const Display& d, double pts) {
-      const auto panel = [&](const EyeArea& a) {
-        return read_back(d.packed_framebuffer(), a.x + (a.width - 160) / 2, a.y + (a.height - 90) / 2, 160, 90);
-      };
-      shown[run][pts] = {panel(left), panel(right)};
-      if (run == 1 && !typed) {
-        display.type(KeyPress::of(U'O'));
-        typed = true;
-      }
-    };
-    auto source = test::open_input(clip);
-    EXPECT_EQ(play(display, *source, options).end, PlayEnd::end_of_file);
-  }
+  const PlayerOptions options = silent_options();
+  const auto without = panels_played(clip, options);
+  const auto with = panels_played(clip, options, KeyPress::of(U'O'));
   int compared = 0;
-  for (const auto& [pts, eyes] : shown[1]) {
-    if (pts < 0.5 || !shown[0].count(pts)) continue;
-    for (int e : {0, 1}) {
-      const Image& with = eyes[static_cast<std::size_t>(e)];
-      const Image& without = shown[0][pts][static_cast<std::size_t>(e)];
-      int changed = 0;
-      for (int y = 0; y < 90; ++y)
-        for (int x = 0; x < 160; ++x) {
-          const float* a = &with.data()[(static_cast<std::size_t>(y) * 160 + x) * 4];
-          const float* b = &without.data()[(static_cast<std::size_t>(y) * 160 + x) * 4];
-          if (std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]) > 0.3f) ++changed;
-        }
-      EXPECT_GT(changed, 100) << "no time line at " << pts << " s in eye " << e;
-    }
+  for (const auto& [pts, eyes] : with) {
+    if (pts < 0.5 || !without.count(pts)) continue;
+    for (std::size_t e : {0u, 1u})
+      EXPECT_GT(differing(eyes[e], without.at(pts)[e], 0.3f), 100) << "no time line at " << pts << " s in eye " << e;
     ++compared;
   }
   EXPECT_GE(compared, 30);
