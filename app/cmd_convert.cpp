@@ -14,6 +14,7 @@
 #include <filesystem>
 #include "app/commands.hpp"
 #include "compositor/frame_compositor.hpp"
+#include "compositor/overlays/subtitle_overlay.hpp"
 #include "core/printable.hpp"
 #include "hmz_output/frame_sink.hpp"
 #include "hmz_output/image_sink.hpp"
@@ -223,8 +224,7 @@ std::optional<int> parse_track_number(const std::string& value, const std::strin
 }
 
 double parse_sub_parallax(const std::optional<double>& parallax) {
-  // More than this pulls the two copies so far apart that the eyes no longer fuse them.
-  constexpr double kMax = 10.0;
+  constexpr double kMax = max_sub_parallax_percent;
   const double value = parallax.value_or(0.0);
   if (!std::isfinite(value) || std::abs(value) > kMax)
     throw UserError(fmt::format("--sub-parallax must be -{0}..{0} (percent of the view width), got {1}", kMax, value),

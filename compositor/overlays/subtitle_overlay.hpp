@@ -17,6 +17,10 @@ std::array<int, 2> subtitle_canvas(const StereoVideoFrame& frame);
 // `width` pixels wide: the left eye's copy moves right by it, the right eye's left.
 int subtitle_shift(double parallax_percent, int width);
 
+// The subtitles' depth either way (--sub-parallax, the keys, a remembered one), in percent of the
+// view width: more pulls the two copies so far apart that the eyes no longer fuse them.
+constexpr double max_sub_parallax_percent = 10.0;
+
 // `subtitle` (subtitle_canvas(frame) in size; an empty one draws nothing) drawn over both views of
 // `frame` (8 or 16 bits a channel), the left eye's copy `parallax_percent` of the view width to the
 // right of the right eye's: positive puts the text in front of the screen, 0 on it. Parts shifted
