@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "compositor/gl/gl_compositor.hpp"
+#include "compositor/overlays/subtitle_overlay.hpp"
 #include "core/printable.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "inputs/test_patterns.hpp"
@@ -96,6 +97,8 @@ void PlayCommands::seek_shown(double target) {
   message_.clear();
   show_progress();
 }
+
+void PlayCommands::decode_again_from_here() { seek_to(position(), ""); }
 
 std::optional<PlayEnd> PlayCommands::other_file(bool next) {
   if (next ? options_.has_next : options_.has_previous) return next ? PlayEnd::next_file : PlayEnd::previous_file;
@@ -218,9 +221,8 @@ std::optional<PlayEnd> PlayCommands::apply(Command command) {
     case Command::next_audio_track: {
       bool changed = false;
       const std::string what = sound_.next_track(changed);
-      // The new track starts where the picture is: a seek there puts the clock, the sound and the
-      // frames back in step.
-      if (changed) seek_to(position(), "");
+      // The new track starts where the picture is, the clock, the sound and the frames in step.
+      if (changed) decode_again_from_here();
       if (!options_.quiet) fmt::print(stderr, "nelf: {}\n", what);  // as the status line named the first
       say(what);
       break;
@@ -234,8 +236,7 @@ std::optional<PlayEnd> PlayCommands::apply(Command command) {
         break;
       }
       subtitles_->shown = !subtitles_->shown;
-      // The frames decoded ahead were drawn as it was: decoded again from the one on screen.
-      seek_to(position(), "");
+      decode_again_from_here();
       say(subtitles_->shown ? "subtitles on" : "subtitles off");
       break;
     case Command::subtitles_nearer:
@@ -244,10 +245,10 @@ std::optional<PlayEnd> PlayCommands::apply(Command command) {
         say("no subtitles");
         break;
       }
-      // --sub-parallax's range: beyond it the two copies no longer fuse.
       const double step = command == Command::subtitles_nearer ? 0.25 : -0.25;
-      subtitles_->parallax_percent = std::clamp(subtitles_->parallax_percent + step, -10.0, 10.0);
-      seek_to(position(), "");
+      subtitles_->parallax_percent =
+          std::clamp(subtitles_->parallax_percent + step, -max_sub_parallax_percent, max_sub_parallax_percent);
+      decode_again_from_here();
       say(fmt::format("subtitle depth {:+.2f} % ({})", subtitles_->parallax_percent.load(),
                       subtitles_->parallax_percent > 0   ? "in front of the screen"
                       : subtitles_->parallax_percent < 0 ? "behind the screen"

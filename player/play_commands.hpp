@@ -92,6 +92,9 @@ class PlayCommands {
 
  private:
   std::optional<PlayEnd> other_file(bool next);
+  // The frames decoded ahead show what a key just changed (the subtitles, the audio track) as it
+  // was: they are decoded again from the one on screen (a seek there).
+  void decode_again_from_here();
   // The time line and the seek bar for two seconds (after a seek, key o).
   void show_progress();
   // Where playback is: the frame on screen, or where a seek goes.
@@ -106,11 +109,10 @@ class PlayCommands {
   FrameScheduler& scheduler_;
   const PlayerOptions& options_;
   std::optional<double> duration_s_;
-  ViewGeometry view_;  // the source's, for the view format a change of the optics asks for
-  bool still_;
-  SubtitleControls* subtitles_;
-  int screenshots_pending_ = 0;  // read by the decoder as it draws them; null: no subtitles                 // a
-                                 // photo: ← and → step through the playlist instead of seeking
+  ViewGeometry view_;            // the source's, for the view format a change of the optics asks for
+  bool still_;                   // a photo: ← and → step through the playlist instead of seeking
+  SubtitleControls* subtitles_;  // read by the decoder as it draws them; null: no subtitles
+  int screenshots_pending_ = 0;  // Ctrl+s pressed, taken after the next render
   std::size_t help_line_ = 0;    // the next line of the key help that h shows
   std::string message_;
   std::chrono::steady_clock::time_point message_until_{};
