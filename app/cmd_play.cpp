@@ -14,6 +14,7 @@
 
 #include "app/commands.hpp"
 #include "app/play_command.hpp"
+#include "compositor/overlays/subtitle_overlay.hpp"
 #include "core/printable.hpp"
 #include "core/user_error.hpp"
 #include "hmz_output/display.hpp"
@@ -24,6 +25,7 @@
 #include "player/depth_input.hpp"
 #include "player/interrupt.hpp"
 #include "player/live_display.hpp"
+#include "player/play_commands.hpp"
 #include "player/play_sound.hpp"
 #include "player/player.hpp"
 #include "player/playlist.hpp"
@@ -39,11 +41,6 @@ KeyRebindings& rebound_keys() {
 }
 
 void warn(const std::string& line) { fmt::print(stderr, "nelf: warning: {}\n", printable(line)); }
-
-std::string clock_time(double seconds) {
-  const long s = std::lround(std::floor(std::max(0.0, seconds)));
-  return fmt::format("{}:{:02d}:{:02d}", s / 3600, static_cast<int>(s / 60 % 60), static_cast<int>(s % 60));
-}
 
 // An input read from stdin: the offscreen output then takes no keys from it.
 bool reads_stdin(const std::string& input) { return input == "-" || input == "pipe:" || input == "pipe:0"; }
@@ -112,16 +109,16 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
     } else if (args.resume && record.position_s && *record.position_s > 0 &&
                (!info.duration_s || *record.position_s < *info.duration_s)) {
       options.start_s = record.position_s;
-      options.announce = fmt::format("resuming at {}", clock_time(*record.position_s));
+      options.announce = fmt::format("resuming at {}", playback::clock_time(*record.position_s));
       if (!args.quiet)
         fmt::print(stderr, "nelf: resuming at {} (--no-resume starts from the beginning)\n",
-                   clock_time(*record.position_s));
+                   playback::clock_time(*record.position_s));
     }
   }
   if (!info.still && subtitles) {
     options.subtitles = std::move(subtitles);
     options.sub_parallax_percent = parse_sub_parallax(args.sub_parallax);
-    if (!args.sub_parallax && record.sub_parallax && std::abs(*record.sub_parallax) <= 10) {
+    if (!args.sub_parallax && record.sub_parallax && std::abs(*record.sub_parallax) <= max_sub_parallax_percent) {
       options.sub_parallax_percent = *record.sub_parallax;
       if (!args.quiet)
         fmt::print(stderr, "nelf: subtitle depth {:g} % as last time (--sub-parallax overrides)\n",
