@@ -122,6 +122,12 @@ Reply set_property(IpcTarget& t, const std::vector<json>& args) {
   return {};
 }
 
+// `command` carried out as its key does; the first reason to end play it gives is kept.
+Reply as_key(IpcTarget& t, Command command) {
+  if (const std::optional<PlayEnd> end = t.commands.apply(command); end && !t.end) t.end = end;
+  return Reply{};
+}
+
 struct IpcCommand {
   std::string_view name;
   Reply (*run)(IpcTarget&, const std::vector<json>& args);
@@ -134,16 +140,8 @@ const IpcCommand commands[] = {
        return Reply{};
      }},
     // The keys' > and <: at the playlist's end mpv stays on the file and says so, as they do.
-    {"playlist-next",
-     [](IpcTarget& t, const std::vector<json>&) {
-       if (const std::optional<PlayEnd> end = t.commands.apply(Command::next_file); end && !t.end) t.end = end;
-       return Reply{};
-     }},
-    {"playlist-prev",
-     [](IpcTarget& t, const std::vector<json>&) {
-       if (const std::optional<PlayEnd> end = t.commands.apply(Command::previous_file); end && !t.end) t.end = end;
-       return Reply{};
-     }},
+    {"playlist-next", [](IpcTarget& t, const std::vector<json>&) { return as_key(t, Command::next_file); }},
+    {"playlist-prev", [](IpcTarget& t, const std::vector<json>&) { return as_key(t, Command::previous_file); }},
     {"get_property",
      [](IpcTarget& t, const std::vector<json>& args) {
        if (args.size() != 1) return Reply{invalid_parameter, {}};
@@ -201,8 +199,7 @@ const IpcCommand commands[] = {
        const std::optional<KeyPress> key = parse_key_name(args[0].get<std::string>());
        if (!key) return Reply{invalid_parameter, {}};
        // The key as if typed: the same binding table, rebindings and commands.
-       if (const std::optional<Command> command = command_for(KeyScope::play, *key, t.keys))
-         if (const std::optional<PlayEnd> end = t.commands.apply(*command); end && !t.end) t.end = end;
+       if (const std::optional<Command> command = command_for(KeyScope::play, *key, t.keys)) return as_key(t, *command);
        return Reply{};
      }},
 };
