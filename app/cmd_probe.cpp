@@ -3,9 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <cctype>
 #include <cmath>
-#include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -81,9 +79,7 @@ ProbeResult probe(const ProbeOptions& options) {
   result.decision = detect_stereo_layout(evidence);
   // FFmpeg sees an MPO's first JPEG only: its layout is the one play and convert read, the two
   // images of the file (the still reader's, which says why it chose it).
-  std::string extension = std::filesystem::path(options.input).extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == ".mpo") {
+  if (is_mpo_name(options.input)) {
     StillOptions still;
     still.layout = evidence.flag;
     still.swap_eyes = options.swap_eyes;

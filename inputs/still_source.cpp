@@ -270,6 +270,8 @@ bool is_still_image_name(const std::string& input) {
   return std::find(still.begin(), still.end(), lowercase_extension(input)) != still.end();
 }
 
+bool is_mpo_name(const std::string& input) { return lowercase_extension(input) == ".mpo"; }
+
 StillStereo load_still(const fs::path& path, const StillOptions& options) {
   if (options.right) {
     if (options.layout && *options.layout != StereoLayout::pair)
@@ -280,7 +282,7 @@ StillStereo load_still(const fs::path& path, const StillOptions& options) {
   if (options.layout == StereoLayout::pair)
     throw StillError(
         fmt::format("{}: layout pair needs the right view as a second file (--right FILE)", path.string()));
-  if (lowercase_extension(path) == ".mpo") {
+  if (is_mpo_name(path.string())) {
     require_file(path);
     return load_mpo(path, options);
   }

@@ -48,6 +48,9 @@ std::vector<std::size_t> find_mpo_images(std::span<const std::byte> bytes);
 // Whether `input` names a still image by its extension (.png, .jpg, .jps, .mpo, .tif, .exr, …, any
 // case): those are read here, everything else as video.
 bool is_still_image_name(const std::string& input);
+// True when `input` is named as an MPO (.mpo, any case): two JPEGs that load_still reads as a pair,
+// where FFmpeg sees the first only.
+bool is_mpo_name(const std::string& input);
 
 struct StillOptions {
   std::optional<StereoLayout> layout;           // --layout; nothing = detect
