@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/ffmpeg_raii.hpp"
+#include "core/language_tags.hpp"
 #include "core/printable.hpp"
 #include "core/user_error.hpp"
 
@@ -146,13 +147,9 @@ struct SubtitleTrack::Impl {
       return streams[static_cast<std::size_t>(*choice.number - 1)];
     }
     if (!choice.languages.empty()) {
-      const auto lower = [](std::string text) {
-        for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-        return text;
-      };
       for (const std::string& wanted : choice.languages)
         for (const int i : streams)
-          if (lower(language(i)) == lower(wanted)) return i;
+          if (same_language_tag(language(i), wanted)) return i;
       std::string asked;
       for (const std::string& wanted : choice.languages) asked += (asked.empty() ? "" : ",") + wanted;
       throw UserError(fmt::format("{}: no subtitle track in {} (--slang): {}", printable(path), printable(asked),

@@ -3,19 +3,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cctype>
 #include <utility>
 
+#include "core/language_tags.hpp"
 #include "core/user_error.hpp"
 
 namespace nelf::playback {
 
 namespace {
-
-std::string lowercase(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 
 std::string track_list(const std::vector<AudioTrack>& tracks) {
   if (tracks.empty()) return "the input has no audio tracks to choose from";
@@ -57,7 +52,7 @@ int choose_audio_track(const std::vector<AudioTrack>& tracks, std::optional<int>
   if (languages.empty()) return 0;
   for (const std::string& language : languages)
     for (const AudioTrack& track : tracks)
-      if (lowercase(track.language) == lowercase(language)) return track.number;
+      if (same_language_tag(track.language, language)) return track.number;
   std::string asked;
   for (const std::string& language : languages) asked += (asked.empty() ? "" : ",") + language;
   throw UserError(fmt::format("no audio track in {} (--alang): {}", asked, track_list(tracks)), 2);
