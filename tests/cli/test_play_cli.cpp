@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "support/frame_log.hpp"
 #include "support/image_files.hpp"
 #include "support/media.hpp"
 #include "support/test_support.hpp"
@@ -40,28 +41,6 @@ std::filesystem::path make_clip(const TempDir& dir, const std::string& name, dou
       "[1][b2]overlay=x='mod(n*5,300)':y=60[r];[l][r]hstack\" -c:v libx264 -preset ultrafast -pix_fmt yuv420p";
   if (audio) args += " -c:a aac -shortest";
   return make_media(dir / name, args);
-}
-
-struct LogRow {
-  std::string event;
-  double pts = 0, clock = 0;
-  std::string audio_clock;
-};
-std::vector<LogRow> read_log(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  EXPECT_EQ(line.rfind("refresh,event,pts_s,clock_s,audio_clock_s,shown,repeated,dropped", 0), 0u) << line;
-  std::vector<LogRow> rows;
-  while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::stringstream s(line);
-    std::string field;
-    while (std::getline(s, field, ',')) f.push_back(field);
-    if (f.size() < 5) continue;
-    rows.push_back({f[1], f[2].empty() ? -1 : std::stod(f[2]), std::stod(f[3]), f[4]});
-  }
-  return rows;
 }
 
 class PlayCli : public ::testing::Test {

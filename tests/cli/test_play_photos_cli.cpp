@@ -5,13 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <cmath>
 #include <string>
 #include <vector>
 
+#include "support/frame_log.hpp"
 #include "support/image_files.hpp"
 #include "support/media.hpp"
 #include "support/test_support.hpp"
@@ -23,27 +24,8 @@ namespace fs = std::filesystem;
 
 std::string q(const fs::path& p) { return shell_quote(p.string()); }
 
-struct Row {
-  std::string event;
-  double pts = -1, clock = 0;
-};
-std::vector<Row> read_log(const fs::path& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  std::vector<Row> rows;
-  while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::stringstream s(line);
-    std::string field;
-    while (std::getline(s, field, ',')) f.push_back(field);
-    if (f.size() < 4) continue;
-    rows.push_back({f[1], f[2].empty() ? -1 : std::stod(f[2]), std::stod(f[3])});
-  }
-  return rows;
-}
 double first_shown_pts(const fs::path& log) {
-  for (const Row& row : read_log(log))
+  for (const LogRow& row : read_log(log))
     if (row.event == "shown") return row.pts;
   return -1;
 }
@@ -97,7 +79,8 @@ TEST_F(PlayPhotos, APhotoStaysOnScreenUntilAKey) {
   const auto rows = read_log(log);
   ASSERT_FALSE(rows.empty());
   // (The first may come with the first frame.)
-  EXPECT_GE(std::count_if(rows.begin(), rows.end(), [](const Row& row) { return row.event == "redrawn"; }), 7) << r.err;
+  EXPECT_GE(std::count_if(rows.begin(), rows.end(), [](const LogRow& row) { return row.event == "redrawn"; }), 7)
+      << r.err;
   EXPECT_GT(rows.back().clock, 0.06);  // past the 40 ms a still used to last
   EXPECT_NE(r.err.find("nelf: 1 frames shown, 0 repeated, 0 dropped"), std::string::npos) << r.err;
 }
