@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -50,6 +51,57 @@ void blend_premultiplied(std::uint8_t* dst, int r, int g, int b, int a) {
   dst[3] = static_cast<std::uint8_t>((255 * a + dst[3] * keep + 127) / 255);
 }
 
+// One picture of a bitmap track: premultiplied RGBA at its place on the subtitle canvas.
+struct BitmapRect {
+  int x = 0, y = 0, w = 0, h = 0;
+  std::vector<std::uint8_t> rgba;
+};
+
+// A bitmap subtitle from `start_s` until `end_s`, authored on a `canvas_w`×`canvas_h` canvas.
+struct BitmapEvent {
+  double start_s = 0.0, end_s = 0.0;
+  int canvas_w = 0, canvas_h = 0;
+  std::vector<BitmapRect> rects;
+};
+
+// A rect of palette indices (AV_PIX_FMT_PAL8: the palette is native-endian ARGB, not
+// premultiplied) as premultiplied RGBA.
+BitmapRect premultiplied(const AVSubtitleRect& rect) {
+  BitmapRect out{rect.x, rect.y, rect.w, rect.h, {}};
+  out.rgba.resize(static_cast<std::size_t>(rect.w) * rect.h * 4);
+  std::uint32_t palette[256] = {};
+  std::memcpy(palette, rect.data[1], static_cast<std::size_t>(std::clamp(rect.nb_colors, 0, 256)) * 4);
+  for (int y = 0; y < rect.h; ++y)
+    for (int x = 0; x < rect.w; ++x) {
+      const std::uint32_t argb = palette[rect.data[0][static_cast<std::size_t>(y) * rect.linesize[0] + x]];
+      const unsigned a = argb >> 24;
+      std::uint8_t* d = &out.rgba[(static_cast<std::size_t>(y) * rect.w + x) * 4];
+      d[0] = static_cast<std::uint8_t>((((argb >> 16) & 0xff) * a + 127) / 255);
+      d[1] = static_cast<std::uint8_t>((((argb >> 8) & 0xff) * a + 127) / 255);
+      d[2] = static_cast<std::uint8_t>(((argb & 0xff) * a + 127) / 255);
+      d[3] = static_cast<std::uint8_t>(a);
+    }
+  return out;
+}
+
+// The premultiplied colour of `rect` at canvas point (`cx`, `cy`) (pixel centres at .5), bilinear
+// between its pixels and transparent outside it: `rgba` gets the four channels.
+void sample(const BitmapRect& rect, double cx, double cy, int rgba[4]) {
+  const double fx = cx - rect.x - 0.5, fy = cy - rect.y - 0.5;
+  const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
+  const double tx = fx - x0, ty = fy - y0;
+  double sum[4] = {};
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      const int x = x0 + i, y = y0 + j;
+      if (x < 0 || y < 0 || x >= rect.w || y >= rect.h) continue;
+      const double weight = (i ? tx : 1.0 - tx) * (j ? ty : 1.0 - ty);
+      const std::uint8_t* p = &rect.rgba[(static_cast<std::size_t>(y) * rect.w + x) * 4];
+      for (int c = 0; c < 4; ++c) sum[c] += weight * p[c];
+    }
+  for (int c = 0; c < 4; ++c) rgba[c] = static_cast<int>(std::lround(sum[c]));
+}
+
 }  // namespace
 
 struct SubtitleTrack::Impl {
@@ -70,6 +122,11 @@ struct SubtitleTrack::Impl {
   std::unique_ptr<ASS_Track, AssTrackDeleter> track;
   int frame_w = 0, frame_h = 0;
   double pixel_aspect = 0.0;
+  // Bitmaps: decoded events in start order, and the canvas of those that do not say theirs.
+  bool bitmap = false;
+  SubtitleStereo stereo = SubtitleStereo::flat;
+  std::vector<BitmapEvent> events;
+  int video_w = 0, video_h = 0;
 
   [[noreturn]] void fail(const std::string& why) const {
     throw UserError(fmt::format("{}: {}", printable(path), why), 1);
@@ -88,6 +145,10 @@ struct SubtitleTrack::Impl {
     const int video = av_find_best_stream(format.get(), AVMEDIA_TYPE_VIDEO, -1, -1, nullptr, 0);
     if (video >= 0 && format->streams[video]->start_time != AV_NOPTS_VALUE)
       offset_s += static_cast<double>(format->streams[video]->start_time) * av_q2d(format->streams[video]->time_base);
+    if (video >= 0) {
+      video_w = format->streams[video]->codecpar->width;
+      video_h = format->streams[video]->codecpar->height;
+    }
     for (unsigned i = 0; i < format->nb_streams; ++i)
       if (static_cast<int>(i) != index) format->streams[i]->discard = AVDISCARD_ALL;
     const AVCodec* decoder = avcodec_find_decoder(stream->codecpar->codec_id);
@@ -98,11 +159,14 @@ struct SubtitleTrack::Impl {
     if (const int err = avcodec_open2(codec.get(), decoder, nullptr); err < 0)
       fail(fmt::format("cannot open the {} decoder: {}", decoder->name, av_error(err)));
     const AVCodecDescriptor* descriptor = avcodec_descriptor_get(stream->codecpar->codec_id);
-    // Bitmap tracks (PGS, DVB, VobSub) decode too, but their drawing is not written yet.
-    if (!descriptor || (descriptor->props & AV_CODEC_PROP_TEXT_SUB) == 0)
-      fail(fmt::format("{} subtitles are bitmaps, which are not drawn yet; text subtitles (SRT, ASS/SSA, WebVTT) are",
-                       decoder->name));
     description = fmt::format("subtitles: {} ({})", path, decoder->name);
+    if (descriptor && (descriptor->props & AV_CODEC_PROP_BITMAP_SUB) != 0) {
+      bitmap = true;
+      read_to(first_packet_horizon());
+      return;
+    }
+    if (!descriptor || (descriptor->props & AV_CODEC_PROP_TEXT_SUB) == 0)
+      fail(fmt::format("{} subtitles are neither text nor bitmaps that nelf draws", decoder->name));
     library.reset(ass_library_init());
     if (!library) fail("libass cannot start");
     ass_set_message_cb(
@@ -159,10 +223,10 @@ struct SubtitleTrack::Impl {
     return av_find_best_stream(format.get(), AVMEDIA_TYPE_SUBTITLE, -1, -1, nullptr, 0);
   }
 
-  // External files hold only subtitles: read them whole. A movie: what its first seconds hold.
-  double first_packet_horizon() const {
-    return format->nb_streams == 1 ? std::numeric_limits<double>::infinity() : 0.0;
-  }
+  // A movie's stream, and bitmaps (a whole film's pictures would fill memory), are read as they
+  // play, seeking back; a text file is read whole.
+  bool streamed() const { return format->nb_streams > 1 || bitmap; }
+  double first_packet_horizon() const { return streamed() ? 0.0 : std::numeric_limits<double>::infinity(); }
 
   double seconds(std::int64_t ts) const { return static_cast<double>(ts) * av_q2d(stream->time_base) - offset_s; }
 
@@ -181,12 +245,98 @@ struct SubtitleTrack::Impl {
       end = seconds(pts + p.duration);
     else if (owned->end_display_time > owned->start_display_time && owned->end_display_time != UINT32_MAX)
       end = seconds(pts) + owned->end_display_time / 1000.0;
+    if (bitmap) {
+      add_bitmaps(*owned, start, end);
+      return;
+    }
     const double duration = std::isfinite(end) ? end - start : 3600.0;
     for (unsigned i = 0; i < owned->num_rects; ++i) {
       const AVSubtitleRect& rect = *owned->rects[i];
       if (rect.type != SUBTITLE_ASS || !rect.ass) continue;
       ass_process_chunk(track.get(), rect.ass, static_cast<int>(std::strlen(rect.ass)), std::llround(start * 1000.0),
                         std::llround(duration * 1000.0));
+    }
+  }
+
+  // The canvas a bitmap is placed on: what the decoder says (PGS's presentation segment, DVB's
+  // display definition, VobSub's size line), else DVB's standard 720×576, else the movie's frame.
+  std::array<int, 2> bitmap_canvas(const AVSubtitle& sub) const {
+    if (codec->width > 0 && codec->height > 0) return {codec->width, codec->height};
+    if (codec->codec_id == AV_CODEC_ID_DVB_SUBTITLE) return {720, 576};
+    if (video_w > 0 && video_h > 0) return {video_w, video_h};
+    int w = 1, h = 1;
+    for (unsigned i = 0; i < sub.num_rects; ++i) {
+      w = std::max(w, sub.rects[i]->x + sub.rects[i]->w);
+      h = std::max(h, sub.rects[i]->y + sub.rects[i]->h);
+    }
+    return {w, h};
+  }
+
+  // A bitmap subtitle replaces the one showing (PGS and DVB compose the whole screen, a DVD shows
+  // one subpicture), so it ends any earlier event still on: a PGS picture says no end of its own,
+  // and an empty one clears the screen.
+  void add_bitmaps(const AVSubtitle& sub, double start, double end) {
+    for (BitmapEvent& e : events)
+      if (e.start_s < start && e.end_s > start) e.end_s = start;
+    BitmapEvent event;
+    event.start_s = start;
+    event.end_s = end;
+    for (unsigned i = 0; i < sub.num_rects; ++i) {
+      const AVSubtitleRect& rect = *sub.rects[i];
+      if (rect.type == SUBTITLE_BITMAP && rect.w > 0 && rect.h > 0 && rect.data[0] && rect.data[1])
+        event.rects.push_back(premultiplied(rect));
+    }
+    if (event.rects.empty()) return;
+    const auto [canvas_w, canvas_h] = bitmap_canvas(sub);
+    event.canvas_w = canvas_w;
+    event.canvas_h = canvas_h;
+    events.push_back(std::move(event));
+  }
+
+  // The events shown at `t_s` drawn into `out`, each eye's part of the canvas scaled to the view.
+  void render_bitmaps(double t_s, SubtitleBitmap& out) {
+    // Those over before the time asked are not shown again without a seek, which reads anew.
+    std::erase_if(events, [&](const BitmapEvent& e) { return e.end_s <= t_s - 1.0; });
+    const bool per_eye = stereo != SubtitleStereo::flat;
+    for (const BitmapEvent& e : events) {
+      if (t_s < e.start_s || t_s >= e.end_s) continue;
+      if (out.rgba.empty()) out.rgba.assign(static_cast<std::size_t>(out.width) * out.height * 4, 0);
+      if (per_eye && out.right_rgba.empty()) out.right_rgba.assign(out.rgba.size(), 0);
+      for (int eye = 0; eye < (per_eye ? 2 : 1); ++eye) {
+        // The part of the canvas this eye sees, [sx, sx + sw) × [sy, sy + sh).
+        double sx = 0, sy = 0, sw = e.canvas_w, sh = e.canvas_h;
+        if (stereo == SubtitleStereo::side_by_side) {
+          sw /= 2;
+          sx = eye * sw;
+        } else if (stereo == SubtitleStereo::top_bottom) {
+          sh /= 2;
+          sy = eye * sh;
+        }
+        std::vector<std::uint8_t>& target = eye == 0 ? out.rgba : out.right_rgba;
+        const double to_view_x = out.width / sw, to_view_y = out.height / sh;
+        for (const BitmapRect& rect : e.rects) {
+          // The view pixels the rect covers, one more each side for the bilinear edge.
+          const int x0 = std::max(0, static_cast<int>(std::floor((rect.x - sx) * to_view_x)) - 1);
+          const int x1 = std::min(out.width, static_cast<int>(std::ceil((rect.x + rect.w - sx) * to_view_x)) + 1);
+          const int y0 = std::max(0, static_cast<int>(std::floor((rect.y - sy) * to_view_y)) - 1);
+          const int y1 = std::min(out.height, static_cast<int>(std::ceil((rect.y + rect.h - sy) * to_view_y)) + 1);
+          for (int y = y0; y < y1; ++y) {
+            const double cy = sy + (y + 0.5) / to_view_y;
+            if (cy < sy || cy >= sy + sh) continue;
+            for (int x = x0; x < x1; ++x) {
+              const double cx = sx + (x + 0.5) / to_view_x;
+              if (cx < sx || cx >= sx + sw) continue;
+              int c[4];
+              sample(rect, cx, cy, c);
+              if (c[3] == 0) continue;
+              // Already premultiplied: "over" is src + dst × (1 − a).
+              std::uint8_t* d = &target[(static_cast<std::size_t>(y) * out.width + x) * 4];
+              for (int k = 0; k < 4; ++k)
+                d[k] = static_cast<std::uint8_t>(std::min(255, c[k] + (d[k] * (255 - c[3]) + 127) / 255));
+            }
+          }
+        }
+      }
     }
   }
 
@@ -213,9 +363,24 @@ struct SubtitleTrack::Impl {
     constexpr double kPreroll = 10.0;  // events that began this long before the seek still show
     const double from = t_s - kPreroll;
     const auto ts = static_cast<std::int64_t>((from + offset_s) * AV_TIME_BASE);
-    if (avformat_seek_file(format.get(), -1, std::numeric_limits<std::int64_t>::min(), ts, ts, 0) < 0) return;
+    // Back to the start, or in a file that cannot seek there, the file is read again from its start:
+    // a format that seeks by an index of what was read (a .sup) finds nothing before its first
+    // packet, and lands after a display set's first segments when seeking to its time.
+    const bool from_start = format->start_time == AV_NOPTS_VALUE || ts <= format->start_time;
+    if (from_start || avformat_seek_file(format.get(), -1, std::numeric_limits<std::int64_t>::min(), ts, ts, 0) < 0) {
+      const int index = stream->index;
+      AVFormatContext* raw = nullptr;
+      if (avformat_open_input(&raw, path.c_str(), nullptr, nullptr) < 0) return;
+      ffmpeg::FormatContextPtr again(raw);
+      if (avformat_find_stream_info(again.get(), nullptr) < 0 || index >= static_cast<int>(again->nb_streams)) return;
+      for (unsigned i = 0; i < again->nb_streams; ++i)
+        if (static_cast<int>(i) != index) again->streams[i]->discard = AVDISCARD_ALL;
+      format = std::move(again);
+      stream = format->streams[index];
+    }
     avcodec_flush_buffers(codec.get());
-    ass_flush_events(track.get());
+    if (track) ass_flush_events(track.get());
+    events.clear();
     at_end = false;
     read_until_s = -std::numeric_limits<double>::infinity();
   }
@@ -279,7 +444,7 @@ std::vector<std::string> SubtitleTrack::beside(const std::string& movie) {
     const fs::path& candidate = entry.path();
     std::string ext = candidate.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext != ".srt" && ext != ".ass" && ext != ".ssa" && ext != ".vtt") continue;
+    if (ext != ".srt" && ext != ".ass" && ext != ".ssa" && ext != ".vtt" && ext != ".sup" && ext != ".idx") continue;
     const std::string name = candidate.stem().string();
     if (name == stem)
       exact.push_back(candidate.string());
@@ -304,7 +469,7 @@ SubtitleBitmap SubtitleTrack::render(double t_s, int width, int height, double a
   Impl& m = *impl_;
   constexpr double kFarAhead = 30.0;  // reading forward beyond this is slower than a seek
   if (t_s < m.last_asked_s - 1e-6 || (!m.at_end && std::isfinite(m.read_until_s) && t_s > m.read_until_s + kFarAhead))
-    if (m.format->nb_streams > 1) m.seek_to(t_s);
+    if (m.streamed()) m.seek_to(t_s);
   m.last_asked_s = t_s;
   // Packets come in decode order: one starting a little after t_s may be what ends the event at t_s.
   m.read_to(t_s + 1.0);
@@ -313,8 +478,23 @@ SubtitleBitmap SubtitleTrack::render(double t_s, int width, int height, double a
   out.height = height;
   if (width <= 0 || height <= 0) return out;
   if (aspect <= 0.0) aspect = static_cast<double>(width) / height;
-  m.render_text(t_s, out, aspect);
+  if (m.bitmap)
+    m.render_bitmaps(t_s, out);
+  else
+    m.render_text(t_s, out, aspect);
   return out;
+}
+
+void SubtitleTrack::set_stereo(SubtitleStereo stereo) {
+  if (stereo != SubtitleStereo::flat && !impl_->bitmap)
+    throw UserError(fmt::format("{}: --sub-stereo is for bitmap subtitles (PGS, DVB, VobSub) authored per eye; "
+                                "these are text, laid out once for both eyes",
+                                printable(impl_->path)),
+                    2);
+  impl_->stereo = stereo;
+  if (stereo != SubtitleStereo::flat)
+    impl_->description +=
+        stereo == SubtitleStereo::side_by_side ? ", per eye side by side" : ", per eye top and bottom";
 }
 
 const std::string& SubtitleTrack::description() const { return impl_->description; }

@@ -10,7 +10,8 @@
 namespace nelf {
 
 std::unique_ptr<SubtitleTrack> choose_subtitles(const std::string& input, const std::string& file, double start_s,
-                                                bool required, bool quiet, const SubtitleStreamChoice& stream) {
+                                                bool required, bool quiet, const SubtitleStreamChoice& stream,
+                                                SubtitleStereo stereo) {
   std::string chosen = file;
   if (chosen.empty() && stream.any()) chosen = input;
   if (chosen.empty()) {
@@ -37,6 +38,7 @@ std::unique_ptr<SubtitleTrack> choose_subtitles(const std::string& input, const 
     fmt::print(stderr, "nelf: warning: {}; playing without subtitles\n", printable(e.what()));
     return nullptr;
   }
+  track->set_stereo(stereo);
   if (!quiet) fmt::print(stderr, "nelf: {}\n", printable(track->description()));
   return track;
 }

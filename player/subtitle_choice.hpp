@@ -12,8 +12,10 @@ namespace nelf {
 // `stream` (--sid, --slang) picks among the streams of `file`, or of the input itself (the files
 // beside it are then not looked at). `required` (--burn-subs): none found throws UserError;
 // otherwise it is null, and subtitles found but not usable are a warning. A `file` or a `stream`
-// asked for that is not usable always throws UserError. Says which track it took unless `quiet`.
+// asked for that is not usable always throws UserError, and so does `stereo` (--sub-stereo) for a
+// text track. Says which track it took unless `quiet`.
 std::unique_ptr<SubtitleTrack> choose_subtitles(const std::string& input, const std::string& file, double start_s,
-                                                bool required, bool quiet, const SubtitleStreamChoice& stream = {});
+                                                bool required, bool quiet, const SubtitleStreamChoice& stream = {},
+                                                SubtitleStereo stereo = SubtitleStereo::flat);
 
 }  // namespace nelf

@@ -8,7 +8,8 @@ namespace nelf {
 namespace {
 
 template <typename Channel>
-void draw_shifted(std::vector<std::uint8_t>& view, int width, int height, const SubtitleBitmap& subtitle, int shift) {
+void draw_shifted(std::vector<std::uint8_t>& view, int width, int height, const std::vector<std::uint8_t>& subtitle,
+                  int shift) {
   constexpr int kMax = sizeof(Channel) == 1 ? 255 : 65535;
   constexpr int kScale = kMax / 255;  // 8-bit subtitle values to the view's channel range
   auto* pixels = reinterpret_cast<Channel*>(view.data());
@@ -16,7 +17,7 @@ void draw_shifted(std::vector<std::uint8_t>& view, int width, int height, const 
     for (int x = 0; x < width; ++x) {
       const int sx = x - shift;
       if (sx < 0 || sx >= width) continue;
-      const std::uint8_t* s = &subtitle.rgba[(static_cast<std::size_t>(y) * width + sx) * 4];
+      const std::uint8_t* s = &subtitle[(static_cast<std::size_t>(y) * width + sx) * 4];
       const int a = s[3];
       if (a == 0) continue;
       Channel* d = &pixels[(static_cast<std::size_t>(y) * width + x) * 4];
@@ -40,15 +41,17 @@ void draw_subtitles(StereoVideoFrame& frame, const SubtitleBitmap& subtitle, dou
   if (subtitle.empty()) return;
   const auto [width, height] = subtitle_canvas(frame);
   if (subtitle.width != width || subtitle.height != height ||
-      subtitle.rgba.size() != static_cast<std::size_t>(width) * height * 4)
+      subtitle.rgba.size() != static_cast<std::size_t>(width) * height * 4 ||
+      (!subtitle.right_rgba.empty() && subtitle.right_rgba.size() != subtitle.rgba.size()))
     throw std::invalid_argument("draw_subtitles: the subtitle is not the size of the views");
   const int shift = subtitle_shift(parallax_percent, width);
+  const std::vector<std::uint8_t>& right = subtitle.right_rgba.empty() ? subtitle.rgba : subtitle.right_rgba;
   if (frame.bits > 8) {
-    draw_shifted<std::uint16_t>(frame.left, width, height, subtitle, shift);
-    draw_shifted<std::uint16_t>(frame.right, width, height, subtitle, -shift);
+    draw_shifted<std::uint16_t>(frame.left, width, height, subtitle.rgba, shift);
+    draw_shifted<std::uint16_t>(frame.right, width, height, right, -shift);
   } else {
-    draw_shifted<std::uint8_t>(frame.left, width, height, subtitle, shift);
-    draw_shifted<std::uint8_t>(frame.right, width, height, subtitle, -shift);
+    draw_shifted<std::uint8_t>(frame.left, width, height, subtitle.rgba, shift);
+    draw_shifted<std::uint8_t>(frame.right, width, height, right, -shift);
   }
 }
 

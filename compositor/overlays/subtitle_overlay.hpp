@@ -23,7 +23,8 @@ constexpr double max_sub_parallax_percent = 10.0;
 
 // `subtitle` (subtitle_canvas(frame) in size; an empty one draws nothing) drawn over both views of
 // `frame` (8 or 16 bits a channel), the left eye's copy `parallax_percent` of the view width to the
-// right of the right eye's: positive puts the text in front of the screen, 0 on it. Parts shifted
+// right of the right eye's: positive puts the text in front of the screen, 0 on it. A subtitle
+// authored per eye (SubtitleBitmap::right_rgba) gives each eye its own, shifted the same way. Parts shifted
 // out of a view are cut off. Throws std::invalid_argument when the sizes differ.
 void draw_subtitles(StereoVideoFrame& frame, const SubtitleBitmap& subtitle, double parallax_percent);
 

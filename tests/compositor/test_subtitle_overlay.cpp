@@ -20,7 +20,7 @@ StereoVideoFrame grey_frame(int width, int height, int bits) {
 
 // One opaque white pixel at (x, y), the rest transparent.
 SubtitleBitmap dot(int width, int height, int x, int y) {
-  SubtitleBitmap s{width, height, std::vector<std::uint8_t>(static_cast<std::size_t>(width) * height * 4, 0)};
+  SubtitleBitmap s{width, height, std::vector<std::uint8_t>(static_cast<std::size_t>(width) * height * 4, 0), {}};
   std::memset(&s.rgba[(static_cast<std::size_t>(y) * width + x) * 4], 255, 4);
   return s;
 }
@@ -63,7 +63,7 @@ TEST(SubtitleOverlay, ShiftedOutOfTheViewIsCutOff) {
 }
 
 TEST(SubtitleOverlay, BlendsPremultipliedOverEightAndSixteenBits) {
-  SubtitleBitmap half{1, 1, {128, 0, 0, 128}};  // red at half opacity, premultiplied
+  SubtitleBitmap half{1, 1, {128, 0, 0, 128}, {}};  // red at half opacity, premultiplied
   StereoVideoFrame eight = grey_frame(1, 1, 8);
   draw_subtitles(eight, half, 0.0);
   EXPECT_EQ(eight.left[0], 128 + (0x40 * 127 + 127) / 255);
@@ -88,10 +88,21 @@ TEST(SubtitleOverlay, BlockMeansTakeASubtitleOfTheirOwnSize) {
   EXPECT_THROW(draw_subtitles(frame, dot(100, 80, 0, 0), 0.0), std::invalid_argument);
 }
 
+TEST(SubtitleOverlay, SubtitlesAuthoredPerEyeGiveEachEyeItsOwnShiftedTheSame) {
+  StereoVideoFrame frame = grey_frame(200, 10, 8);
+  SubtitleBitmap eyes = dot(200, 10, 50, 5);
+  eyes.right_rgba = dot(200, 10, 150, 5).rgba;
+  draw_subtitles(frame, eyes, 5.0);  // 5 % of 200 px: 10 px apart
+  EXPECT_EQ(white_columns(frame.left, 200, 5), std::vector<int>{55});
+  EXPECT_EQ(white_columns(frame.right, 200, 5), std::vector<int>{145});
+  eyes.right_rgba.resize(4);
+  EXPECT_THROW(draw_subtitles(frame, eyes, 0.0), std::invalid_argument);
+}
+
 TEST(SubtitleOverlay, AnEmptySubtitleDrawsNothing) {
   StereoVideoFrame frame = grey_frame(10, 10, 8);
   const StereoVideoFrame before = frame;
-  draw_subtitles(frame, SubtitleBitmap{10, 10, {}}, 3.0);
+  draw_subtitles(frame, SubtitleBitmap{10, 10, {}, {}}, 3.0);
   EXPECT_EQ(frame.left, before.left);
   EXPECT_EQ(frame.right, before.right);
 }

@@ -72,10 +72,11 @@ TEST(SubtitleTrack, StartMovesTheCallersTimeZero) {
 
 TEST(SubtitleTrack, FindsTheFilesBesideAMovieAsMpvDoes) {
   TempDir dir;
-  for (const char* name : {"movie.mkv", "movie.srt", "movie.en.ass", "movie.de.vtt", "other.srt", "movie.txt"})
+  for (const char* name :
+       {"movie.mkv", "movie.srt", "movie.en.ass", "movie.de.vtt", "movie.fr.sup", "other.srt", "movie.txt"})
     test::write_file(dir / name, "x");
   const std::vector<std::string> expected{(dir / "movie.srt").string(), (dir / "movie.de.vtt").string(),
-                                          (dir / "movie.en.ass").string()};
+                                          (dir / "movie.en.ass").string(), (dir / "movie.fr.sup").string()};
   EXPECT_EQ(SubtitleTrack::beside((dir / "movie.mkv").string()), expected);
   EXPECT_TRUE(SubtitleTrack::beside((dir / "missing.mkv").string()).empty());
 }
