@@ -44,6 +44,7 @@ struct ConvertArgs : CommonArgs {
   bool burn_subs = false;
   std::string sub_file;
   std::optional<double> sub_parallax;
+  std::string sub_stereo;
   std::string sid = "auto";
   std::vector<std::string> slang;
 };
@@ -161,12 +162,15 @@ void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
   }
   if (!args.burn_subs && !args.sub_file.empty()) throw UserError("--sub-file needs --burn-subs", 2);
   if (!args.burn_subs && args.sub_parallax) throw UserError("--sub-parallax needs --burn-subs", 2);
+  if (!args.burn_subs && !args.sub_stereo.empty()) throw UserError("--sub-stereo needs --burn-subs", 2);
   if (!args.burn_subs && (args.sid != "auto" || !args.slang.empty()))
     throw UserError("--sid and --slang choose the track --burn-subs draws", 2);
   if (args.sid == "no") throw UserError("--sid no: leave out --burn-subs to draw no subtitles", 2);
   if (args.burn_subs) {
-    r.burn_subs = SubtitleBurn{
-        args.sub_file, parse_sub_parallax(args.sub_parallax), {parse_track_number(args.sid, "--sid"), args.slang}};
+    r.burn_subs = SubtitleBurn{args.sub_file,
+                               parse_sub_parallax(args.sub_parallax),
+                               {parse_track_number(args.sid, "--sid"), args.slang},
+                               parse_sub_stereo(args.sub_stereo)};
   }
   r.quiet = args.quiet;
   r.strict = args.strict;
@@ -221,6 +225,16 @@ std::optional<int> parse_track_number(const std::string& value, const std::strin
   if (error != std::errc() || end != value.data() + value.size() || number < 1)
     throw UserError(fmt::format("{} {}: a track number from 1, auto or no", option, printable(value)), 2);
   return number;
+}
+
+SubtitleStereo parse_sub_stereo(const std::string& value) {
+  if (value.empty()) return SubtitleStereo::flat;
+  if (value == "sbs") return SubtitleStereo::side_by_side;
+  if (value == "tab") return SubtitleStereo::top_bottom;
+  throw UserError(fmt::format("--sub-stereo {}: sbs or tab (the subtitle pictures hold both eyes side by side or top "
+                              "and bottom)",
+                              printable(value)),
+                  2);
 }
 
 double parse_sub_parallax(const std::optional<double>& parallax) {
@@ -387,10 +401,13 @@ void add_convert_command(CLI::App& app) {
                 "Video: draw subtitles into both eyes (--sub-file, else INPUT.srt/.ass/.vtt beside the input, else "
                 "the input's first subtitle track)");
   cmd->add_option("--sub-file", args->sub_file,
-                  "Video, with --burn-subs: the subtitle file (SRT, ASS/SSA, WebVTT, ...)");
+                  "Video, with --burn-subs: the subtitle file (SRT, ASS/SSA, WebVTT, PGS .sup, VobSub .idx, ...)");
   cmd->add_option("--sub-parallax", args->sub_parallax,
                   "Video, with --burn-subs: the subtitles' depth in percent of the view width (positive = in front "
                   "of the screen; default 0, on it)");
+  cmd->add_option("--sub-stereo", args->sub_stereo,
+                  "Video, with --burn-subs: bitmap subtitles (PGS, DVB, VobSub) authored per eye, sbs (left eye's in "
+                  "the left half) or tab (left eye's on top)");
   cmd->add_option("--sid", args->sid,
                   "Video, with --burn-subs: the subtitle track by number (1 = the file's first subtitle stream, or "
                   "--sub-file's), or auto")

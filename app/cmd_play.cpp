@@ -73,7 +73,8 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
   const SubtitleStreamChoice stream{parse_track_number(args.sid, "--sid"), args.slang};
   if (args.subtitles && !args.no_subs && args.sid != "no" &&
       (!args.sub_file.empty() || std::filesystem::is_regular_file(request.input, not_a_file)))
-    subtitles = choose_subtitles(request.input, args.sub_file, 0.0, false, args.quiet, stream);
+    subtitles = choose_subtitles(request.input, args.sub_file, 0.0, false, args.quiet, stream,
+                                 parse_sub_stereo(args.sub_stereo));
   const auto source = open_source_for_depth(request, common.compositor.depth, common.profile);
   const SourceInfo info = source->info();
 
@@ -184,7 +185,9 @@ PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::
     throw UserError("--image-duration must be more than 0 seconds", 2);
   if (args.no_subs && !args.sub_file.empty()) throw UserError("--no-subs and --sub-file contradict each other", 2);
   if (args.no_subs && args.sub_parallax) throw UserError("--sub-parallax does nothing with --no-subs", 2);
+  if (args.no_subs && !args.sub_stereo.empty()) throw UserError("--sub-stereo does nothing with --no-subs", 2);
   parse_sub_parallax(args.sub_parallax);  // out of range: said before anything opens
+  parse_sub_stereo(args.sub_stereo);
   parse_track_number(args.sid, "--sid");
   const std::vector<std::string> entries = expand_playlist(inputs, warn);
   if (entries.size() > 1 && !args.right.empty())
@@ -285,8 +288,8 @@ void add_play_command(CLI::App& app) {
   add_sound_options(*cmd, *args);
   args->subtitles = true;
   cmd->add_option("--sub-file", args->sub_file,
-                  "Subtitles from this file (SRT, ASS/SSA, WebVTT, ...; default: INPUT.srt/.ass/.vtt beside the "
-                  "input, else the input's first subtitle track)");
+                  "Subtitles from this file (SRT, ASS/SSA, WebVTT, PGS .sup, VobSub .idx, ...; default: "
+                  "INPUT.srt/.ass/.vtt/.sup/.idx beside the input, else the input's first subtitle track)");
   cmd->add_flag("--no-subs", args->no_subs, "Show no subtitles (as --sid no)");
   cmd->add_option("--sid", args->sid,
                   "Subtitle track: its number (1 = the file's first subtitle stream, or --sub-file's), auto or no")
@@ -295,6 +298,9 @@ void add_play_command(CLI::App& app) {
       ->delimiter(',');
   cmd->add_option("--sub-parallax", args->sub_parallax,
                   "The subtitles' depth in percent of the view width (positive = in front of the screen; default 0)");
+  cmd->add_option("--sub-stereo", args->sub_stereo,
+                  "Bitmap subtitles (PGS, DVB, VobSub) authored per eye: sbs (left eye's in the left half) or tab "
+                  "(left eye's on top)");
   cmd->callback([args] {
     args->resume = !args->no_resume;
     args->remember = true;

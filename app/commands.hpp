@@ -12,6 +12,7 @@
 #include "hmz_output/image_sink.hpp"
 #include "hmz_output/signal.hpp"
 #include "inputs/stereo_layout.hpp"
+#include "inputs/subtitle_track.hpp"
 #include "optics/profile.hpp"
 
 namespace nelf::app {
@@ -26,6 +27,10 @@ std::optional<StereoLayout> parse_layout_option(const std::string& name);
 // --sub-parallax of play and convert --burn-subs (percent of the view width; unset: 0). Throws
 // UserError (status 2) beyond ±10 %, where the two copies no longer fuse into one.
 double parse_sub_parallax(const std::optional<double>& parallax);
+
+// --sub-stereo of play and convert --burn-subs: "" (flat), sbs or tab. Throws UserError (status
+// 2) naming the accepted values.
+SubtitleStereo parse_sub_stereo(const std::string& value);
 
 // --aid and --sid: N (the N-th track of its kind, from 1), auto or no; nullopt for auto and no.
 // Throws UserError (status 2) naming `option` otherwise.

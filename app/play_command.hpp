@@ -36,6 +36,7 @@ struct PlayArgs : CommonArgs {
   bool no_subs = false;
   std::string sub_file;
   std::optional<double> sub_parallax;
+  std::string sub_stereo;    // --sub-stereo: "" (flat), sbs or tab
   std::string sid = "auto";  // a track number, auto or no
   std::vector<std::string> slang;
 };

@@ -119,13 +119,13 @@ void convert_video(const VideoConvertRequest& r) {
   std::error_code missing;
   const bool subtitles_first = r.burn_subs && (!r.burn_subs->file.empty() || std::filesystem::exists(r.input, missing));
   std::unique_ptr<SubtitleTrack> subtitles =
-      subtitles_first
-          ? choose_subtitles(r.input, r.burn_subs->file, r.start_s.value_or(0.0), true, r.quiet, r.burn_subs->stream)
-          : nullptr;
+      subtitles_first ? choose_subtitles(r.input, r.burn_subs->file, r.start_s.value_or(0.0), true, r.quiet,
+                                         r.burn_subs->stream, r.burn_subs->stereo)
+                      : nullptr;
   std::unique_ptr<Source> source = open_source_for_depth(request, r.compositor.depth, r.profile);
   if (r.burn_subs && !subtitles)
-    subtitles =
-        choose_subtitles(r.input, r.burn_subs->file, r.start_s.value_or(0.0), true, r.quiet, r.burn_subs->stream);
+    subtitles = choose_subtitles(r.input, r.burn_subs->file, r.start_s.value_or(0.0), true, r.quiet,
+                                 r.burn_subs->stream, r.burn_subs->stereo);
   // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
   const ViewGeometry view = source->info().view;
   source->negotiate({stereo_prefilter_block(r.profile, r.compositor, view.width, view.height, view.aspect)});

@@ -19,6 +19,7 @@ struct SubtitleBurn {
   std::string file;               // --sub-file; "" = a subtitle file beside the input, else its own track
   double parallax_percent = 0.0;  // --sub-parallax: of the view width, positive = in front of the screen
   SubtitleStreamChoice stream;    // --sid, --slang
+  SubtitleStereo stereo = SubtitleStereo::flat;  // --sub-stereo
 };
 
 struct VideoConvertRequest {
