@@ -71,8 +71,9 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
   std::shared_ptr<SubtitleTrack> subtitles;
   std::error_code not_a_file;
   const SubtitleStreamChoice stream{parse_track_number(args.sid, "--sid"), args.slang};
-  if (args.subtitles && !args.no_subs && args.sid != "no" &&
-      (!args.sub_file.empty() || std::filesystem::is_regular_file(request.input, not_a_file)))
+  const bool has_own_subtitles =
+      args.subtitles && (!args.sub_file.empty() || std::filesystem::is_regular_file(request.input, not_a_file));
+  if (has_own_subtitles && !args.no_subs && args.sid != "no")
     subtitles = choose_subtitles(request.input, args.sub_file, 0.0, false, args.quiet, stream,
                                  parse_sub_stereo(args.sub_stereo));
   const auto source = open_source_for_depth(request, common.compositor.depth, common.profile);
@@ -116,15 +117,20 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
                    playback::clock_time(*record.position_s));
     }
   }
-  if (!info.still && subtitles) {
-    options.subtitles = std::move(subtitles);
+  // What j and J switch among, also when none shows at first (--no-subs, --sid no).
+  std::vector<SubtitleTrackRef> tracks;
+  if (!info.still && has_own_subtitles) tracks = subtitle_tracks(request.input, args.sub_file);
+  if (!info.still && (subtitles || !tracks.empty())) {
+    options.subtitle_tracks = std::move(tracks);
+    options.sub_stereo = parse_sub_stereo(args.sub_stereo);
     options.sub_parallax_percent = parse_sub_parallax(args.sub_parallax);
     if (!args.sub_parallax && record.sub_parallax && std::abs(*record.sub_parallax) <= max_sub_parallax_percent) {
       options.sub_parallax_percent = *record.sub_parallax;
-      if (!args.quiet)
+      if (!args.quiet && subtitles)
         fmt::print(stderr, "nelf: subtitle depth {:g} % as last time (--sub-parallax overrides)\n",
                    *record.sub_parallax);
     }
+    options.subtitles = std::move(subtitles);
   }
   if (options.start_s && !info.seekable)
     throw UserError(

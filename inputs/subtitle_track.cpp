@@ -102,6 +102,18 @@ void sample(const BitmapRect& rect, double cx, double cy, int rgba[4]) {
   for (int c = 0; c < 4; ++c) rgba[c] = static_cast<int>(std::lround(sum[c]));
 }
 
+std::string stream_language(const AVFormatContext& format, unsigned i) {
+  const AVDictionaryEntry* tag = av_dict_get(format.streams[i]->metadata, "language", nullptr, 0);
+  return tag ? tag->value : "";
+}
+
+// "eng, subrip": how a track list names a subtitle stream.
+std::string stream_words(const AVFormatContext& format, unsigned i) {
+  const std::string language = stream_language(format, i);
+  return fmt::format("{}, {}", language.empty() ? "no language" : language,
+                     avcodec_get_name(format.streams[i]->codecpar->codec_id));
+}
+
 }  // namespace
 
 struct SubtitleTrack::Impl {
@@ -191,17 +203,11 @@ struct SubtitleTrack::Impl {
     for (unsigned i = 0; i < format->nb_streams; ++i)
       if (format->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_SUBTITLE) streams.push_back(static_cast<int>(i));
     if (streams.empty()) fail("no subtitle stream");
-    const auto language = [&](int i) {
-      const AVDictionaryEntry* tag = av_dict_get(format->streams[i]->metadata, "language", nullptr, 0);
-      return std::string(tag ? tag->value : "");
-    };
+    const auto language = [&](int i) { return stream_language(*format, static_cast<unsigned>(i)); };
     const auto list = [&] {
       std::string all;
-      for (std::size_t n = 0; n < streams.size(); ++n) {
-        const std::string lang = language(streams[n]);
-        all += fmt::format("{}{}: {}, {}", n ? "; " : "", n + 1, lang.empty() ? "no language" : lang,
-                           avcodec_get_name(format->streams[streams[n]]->codecpar->codec_id));
-      }
+      for (std::size_t n = 0; n < streams.size(); ++n)
+        all += fmt::format("{}{}: {}", n ? "; " : "", n + 1, stream_words(*format, static_cast<unsigned>(streams[n])));
       return all;
     };
     if (choice.number) {
@@ -457,12 +463,15 @@ std::vector<std::string> SubtitleTrack::beside(const std::string& movie) {
   return exact;
 }
 
-bool SubtitleTrack::has_subtitles(const std::string& path) {
+std::vector<std::string> SubtitleTrack::streams(const std::string& path) {
   AVFormatContext* raw = nullptr;
-  if (avformat_open_input(&raw, path.c_str(), nullptr, nullptr) < 0) return false;
+  if (avformat_open_input(&raw, path.c_str(), nullptr, nullptr) < 0) return {};
   const ffmpeg::FormatContextPtr format(raw);
-  if (avformat_find_stream_info(format.get(), nullptr) < 0) return false;
-  return av_find_best_stream(format.get(), AVMEDIA_TYPE_SUBTITLE, -1, -1, nullptr, 0) >= 0;
+  if (avformat_find_stream_info(format.get(), nullptr) < 0) return {};
+  std::vector<std::string> found;
+  for (unsigned i = 0; i < format->nb_streams; ++i)
+    if (format->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_SUBTITLE) found.push_back(stream_words(*format, i));
+  return found;
 }
 
 SubtitleBitmap SubtitleTrack::render(double t_s, int width, int height, double aspect) {
@@ -498,5 +507,14 @@ void SubtitleTrack::set_stereo(SubtitleStereo stereo) {
 }
 
 const std::string& SubtitleTrack::description() const { return impl_->description; }
+
+const std::string& SubtitleTrack::path() const { return impl_->path; }
+
+int SubtitleTrack::stream_number() const {
+  int number = 0;
+  for (unsigned i = 0; i <= static_cast<unsigned>(impl_->stream->index); ++i)
+    if (impl_->format->streams[i]->codecpar->codec_type == AVMEDIA_TYPE_SUBTITLE) ++number;
+  return number;
+}
 
 }  // namespace nelf

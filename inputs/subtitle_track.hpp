@@ -42,8 +42,10 @@ class SubtitleTrack {
   // the exact name first, then the others in name order.
   static std::vector<std::string> beside(const std::string& movie);
 
-  // Whether `path` has a subtitle stream (false also when it cannot be opened).
-  static bool has_subtitles(const std::string& path);
+  // The subtitle streams of `path` in file order, as "eng, subrip" ("no language, …" untagged);
+  // none also when it cannot be opened.
+  static std::vector<std::string> streams(const std::string& path);
+  static bool has_subtitles(const std::string& path) { return !streams(path).empty(); }
 
   // What is shown at `t_s` (caller's time), drawn for view pixels of `width`×`height` that are
   // displayed at `aspect` (0 = width / height): text laid out at that aspect, so that a squeezed
@@ -58,6 +60,9 @@ class SubtitleTrack {
 
   // "subtitles: movie.srt (subrip)".
   const std::string& description() const;
+  // The file, and which of its subtitle streams this is (from 1, as --sid counts).
+  const std::string& path() const;
+  int stream_number() const;
 
  private:
   struct Impl;

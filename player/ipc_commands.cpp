@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <sstream>
@@ -59,7 +60,43 @@ struct Property {
   std::optional<json> (*get)(IpcTarget&);
   // false: the value is not one the property takes ("invalid parameter"); null: read-only.
   bool (*set)(IpcTarget&, const json&);
+  // cycle's step through a choice (+1, or -1 for "down"); null: a flag, which cycle toggles.
+  void (*cycle)(IpcTarget&, int step);
 };
+
+// A track id as mpv gives it: its number, or false for none.
+json track_id(int number) { return number > 0 ? json(number) : json(false); }
+
+// A track id as mpv takes it: a number from 1 (or its text), or false / "no" for none (0).
+std::optional<int> track_number(const json& value) {
+  if (const std::optional<bool> off = flag(value); off && !*off) return 0;
+  const std::optional<double> n = number(value);
+  if (!n || *n < 1 || *n != std::floor(*n) || *n > 1e6) return std::nullopt;
+  return static_cast<int>(*n);
+}
+
+std::optional<json> subtitle_track_id(IpcTarget& t) { return track_id(t.commands.subtitle_track()); }
+bool set_subtitle_track_id(IpcTarget& t, const json& v) {
+  const std::optional<int> n = track_number(v);
+  return n && t.commands.set_subtitle_track(*n);
+}
+void cycle_subtitle_track(IpcTarget& t, int step) {
+  t.commands.apply(step > 0 ? Command::next_subtitle_track : Command::previous_subtitle_track);
+}
+
+std::optional<json> audio_track_id(IpcTarget& t) { return track_id(t.commands.audio_track()); }
+bool set_audio_track_id(IpcTarget& t, const json& v) {
+  const std::optional<int> n = track_number(v);
+  return n && *n > 0 && t.commands.set_audio_track(*n);
+}
+void cycle_audio_track(IpcTarget& t, int step) {
+  const int count = t.commands.audio_track_count();
+  if (count < 2) {
+    t.commands.apply(Command::next_audio_track);  // says why nothing changes
+    return;
+  }
+  t.commands.set_audio_track((t.commands.audio_track() - 1 + step + count) % count + 1);
+}
 
 const Property properties[] = {
     {"pause", [](IpcTarget& t) -> std::optional<json> { return t.state.paused; },
@@ -68,43 +105,52 @@ const Property properties[] = {
        if (!paused) return false;
        if (*paused != t.state.paused) t.commands.apply(Command::pause);
        return true;
-     }},
+     },
+     nullptr},
     {"time-pos", [](IpcTarget& t) -> std::optional<json> { return time_pos(t); },
      [](IpcTarget& t, const json& v) {
        const std::optional<double> to = number(v);
        if (!to) return false;
        t.commands.seek_shown(*to);
        return true;
-     }},
+     },
+     nullptr},
     {"duration",
      [](IpcTarget& t) -> std::optional<json> {
        if (!t.duration_s) return std::nullopt;
        return *t.duration_s;
      },
-     nullptr},
+     nullptr, nullptr},
     {"percent-pos",
      [](IpcTarget& t) -> std::optional<json> {
        if (!t.duration_s || *t.duration_s <= 0) return std::nullopt;
        return 100.0 * time_pos(t) / *t.duration_s;
      },
-     nullptr},
+     nullptr, nullptr},
     {"filename", [](IpcTarget& t) -> std::optional<json> { return std::filesystem::path(t.path).filename().string(); },
-     nullptr},
-    {"path", [](IpcTarget& t) -> std::optional<json> { return t.path; }, nullptr},
+     nullptr, nullptr},
+    {"path", [](IpcTarget& t) -> std::optional<json> { return t.path; }, nullptr, nullptr},
     {"volume", [](IpcTarget& t) -> std::optional<json> { return t.commands.volume(); },
      [](IpcTarget& t, const json& v) {
        const std::optional<double> to = number(v);
        if (!to || *to < 0 || *to > 130) return false;  // --volume's range
        t.commands.set_volume(*to);
        return true;
-     }},
+     },
+     nullptr},
     {"mute", [](IpcTarget& t) -> std::optional<json> { return t.commands.muted(); },
      [](IpcTarget& t, const json& v) {
        const std::optional<bool> mute = flag(v);
        if (!mute) return false;
        t.commands.set_mute(*mute);
        return true;
-     }},
+     },
+     nullptr},
+    // mpv's track ids: a number, false for none. sub and audio are mpv's other names for them.
+    {"sid", subtitle_track_id, set_subtitle_track_id, cycle_subtitle_track},
+    {"sub", subtitle_track_id, set_subtitle_track_id, cycle_subtitle_track},
+    {"aid", audio_track_id, set_audio_track_id, cycle_audio_track},
+    {"audio", audio_track_id, set_audio_track_id, cycle_audio_track},
 };
 
 const Property* property_named(const json& name) {
@@ -158,7 +204,11 @@ const IpcCommand commands[] = {
        if (args.empty() || args.size() > 2) return Reply{invalid_parameter, {}};
        const Property* p = property_named(args[0]);
        if (!p) return Reply{property_not_found, {}};
-       // Only a flag cycles here (mpv's cycle of a choice property has no such property yet).
+       if (p->cycle) {
+         if (args.size() == 2 && args[1] != "up" && args[1] != "down") return Reply{invalid_parameter, {}};
+         p->cycle(t, args.size() == 2 && args[1] == "down" ? -1 : 1);
+         return Reply{};
+       }
        const std::optional<json> now = p->get ? p->get(t) : std::nullopt;
        if (!now || !now->is_boolean() || !p->set) return Reply{invalid_parameter, {}};
        p->set(t, !now->get<bool>());

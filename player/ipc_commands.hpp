@@ -3,9 +3,9 @@
 // that mpv's remotes and scripts drive nelf: {"command": ["seek", 10, "relative"], "request_id": 7}
 // → {"data": …, "error": "success", "request_id": 7}. Commands (quit, seek, cycle, set,
 // set_property, get_property, keypress, playlist-next, playlist-prev) and properties (pause,
-// time-pos, duration, percent-pos, filename, path, volume, mute) are tables (ipc_commands.cpp): another is one row.
-// Everything they change goes through PlayCommands, as the keys do. A line that is not JSON is a command as mpv's
-// input.conf writes it ("cycle pause"), run without a reply, as mpv does.
+// time-pos, duration, percent-pos, filename, path, volume, mute, sid/sub, aid/audio) are tables (ipc_commands.cpp):
+// another is one row. Everything they change goes through PlayCommands, as the keys do. A line that is not JSON is a
+// command as mpv's input.conf writes it ("cycle pause"), run without a reply, as mpv does.
 #include <optional>
 #include <string>
 #include <string_view>

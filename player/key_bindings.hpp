@@ -35,6 +35,8 @@ enum class Command {
   previous_file,
   next_audio_track,
   toggle_subtitles,
+  next_subtitle_track,
+  previous_subtitle_track,
   subtitles_nearer,
   subtitles_farther,
   screenshot,

@@ -11,6 +11,7 @@
 #include "compositor/gl/gl_compositor.hpp"
 #include "compositor/overlays/subtitle_overlay.hpp"
 #include "core/printable.hpp"
+#include "core/user_error.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "inputs/test_patterns.hpp"
 
@@ -99,6 +100,62 @@ void PlayCommands::seek_shown(double target) {
 }
 
 void PlayCommands::decode_again_from_here() { seek_to(position(), ""); }
+
+int PlayCommands::index_of_first_track(const PlayerOptions& options) {
+  if (!options.subtitles) return -1;
+  for (std::size_t i = 0; i < options.subtitle_tracks.size(); ++i)
+    if (options.subtitle_tracks[i].path == options.subtitles->path() &&
+        options.subtitle_tracks[i].stream == options.subtitles->stream_number())
+      return static_cast<int>(i);
+  return -1;
+}
+
+bool PlayCommands::set_subtitle_track(int number) {
+  const std::vector<SubtitleTrackRef>& tracks = options_.subtitle_tracks;
+  if (!subtitles_ || number < 0 || number > static_cast<int>(tracks.size())) return false;
+  std::string what;
+  bool ok = true;
+  // (v's hiding stays as it is, as mpv's sub-visibility does.)
+  if (number == 0) {
+    subtitles_->track.store(nullptr);
+    what = "Subtitles: off";
+  } else {
+    const SubtitleTrackRef& ref = tracks[static_cast<std::size_t>(number - 1)];
+    const std::string name = std::filesystem::path(ref.path).filename().string();
+    try {
+      subtitles_->track = open_subtitle_track(ref, options_.sub_stereo);
+      what = fmt::format("Subtitles: track {}/{} ({}, {})", number, tracks.size(), ref.words, name);
+    } catch (const UserError& e) {
+      subtitles_->track.store(nullptr);
+      what = fmt::format("Subtitles: track {}/{} cannot be shown ({})", number, tracks.size(), e.what());
+      ok = false;
+    }
+  }
+  subtitle_index_ = number - 1;  // a track that cannot be shown is passed by the next j
+  decode_again_from_here();
+  if (!options_.quiet) fmt::print(stderr, "nelf: {}\n", printable(what));
+  say(what);
+  return ok;
+}
+
+void PlayCommands::cycle_subtitles(int step) {
+  const int count = static_cast<int>(options_.subtitle_tracks.size());
+  if (!subtitles_ || count == 0) {
+    say("no subtitles");
+    return;
+  }
+  // Numbers 0 (off) to count, in a ring.
+  set_subtitle_track(((subtitle_index_ + 1 + step) % (count + 1) + count + 1) % (count + 1));
+}
+
+bool PlayCommands::set_audio_track(int number) {
+  bool changed = false;
+  const std::string what = sound_.set_track(number, changed);
+  if (changed) decode_again_from_here();
+  if (!options_.quiet) fmt::print(stderr, "nelf: {}\n", what);
+  say(what);
+  return changed || number == sound_.track();
+}
 
 std::optional<PlayEnd> PlayCommands::other_file(bool next) {
   if (next ? options_.has_next : options_.has_previous) return next ? PlayEnd::next_file : PlayEnd::previous_file;
@@ -229,6 +286,10 @@ std::optional<PlayEnd> PlayCommands::apply(Command command) {
     }
     case Command::screenshot:
       ++screenshots_pending_;
+      break;
+    case Command::next_subtitle_track:
+    case Command::previous_subtitle_track:
+      cycle_subtitles(command == Command::next_subtitle_track ? 1 : -1);
       break;
     case Command::toggle_subtitles:
       if (!subtitles_) {

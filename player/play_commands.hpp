@@ -20,16 +20,21 @@
 #include "player/frame_scheduler.hpp"
 #include "player/key_bindings.hpp"
 #include "player/play_sound.hpp"
+#include "player/player.hpp"
+#include "player/subtitle_choice.hpp"
 
 namespace nelf::playback {
 
 // The calibration grid (key c): calibrate's grid pattern at the views' size and the optics.
 FrameCompositor::GridPattern calibration_grid_pattern();
 
-// What the decoder reads as it draws the subtitles into each frame, and the keys change: whether
-// they show (v) and their depth (r R), in percent of the view width.
+// What the decoder reads as it draws the subtitles into each frame, and the keys change: the track
+// (j J: null for none; replaced on the display's thread while the decoder holds the one it draws
+// with), whether they show (v) and their depth (r R), in percent of the view width.
 struct SubtitleControls {
-  explicit SubtitleControls(double parallax) : parallax_percent(parallax) {}
+  SubtitleControls(std::shared_ptr<SubtitleTrack> first, double parallax)
+      : track(std::move(first)), parallax_percent(parallax) {}
+  std::atomic<std::shared_ptr<SubtitleTrack>> track;
   std::atomic<bool> shown{true};
   std::atomic<double> parallax_percent;
 };
@@ -61,7 +66,8 @@ class PlayCommands {
         duration_s_(duration_s),
         view_(view),
         still_(still),
-        subtitles_(subtitles) {}
+        subtitles_(subtitles),
+        subtitle_index_(index_of_first_track(options)) {}
 
   // Carries out `command`; why play ends now, if it does (quit, another file of the playlist).
   std::optional<PlayEnd> apply(Command command);
@@ -79,6 +85,15 @@ class PlayCommands {
   void set_mute(bool mute) {
     if (mute != sound_.muted()) say(sound_.toggle_mute());
   }
+  // The subtitle track shown, from 1 in options.subtitle_tracks (0: none), and the one to show
+  // (0: none), as j J and the IPC's sid change it, saying so on screen. False when there is no
+  // such track or it cannot be read (said on screen too).
+  int subtitle_track() const { return subtitles_ && subtitles_->track.load() ? subtitle_index_ + 1 : 0; }
+  bool set_subtitle_track(int number);
+  // The audio track playing (its number, from 1; 0 when there is no sound), and the one to play.
+  int audio_track() const { return sound_.track(); }
+  int audio_track_count() const { return sound_.track_count(); }
+  bool set_audio_track(int number);
   // A screenshot asked for (Ctrl+s) is taken once a frame is on the display: the packed frame
   // into the first free nelf-shotNNNN.png of the current folder. Called after each refresh's render.
   void take_pending_screenshot();
@@ -92,6 +107,10 @@ class PlayCommands {
 
  private:
   std::optional<PlayEnd> other_file(bool next);
+  // Where options.subtitles is in options.subtitle_tracks; -1 for none.
+  static int index_of_first_track(const PlayerOptions& options);
+  // j / J: the next or previous of the subtitle tracks, "off" between the last and the first.
+  void cycle_subtitles(int step);
   // The frames decoded ahead show what a key just changed (the subtitles, the audio track) as it
   // was: they are decoded again from the one on screen (a seek there).
   void decode_again_from_here();
@@ -112,6 +131,7 @@ class PlayCommands {
   ViewGeometry view_;            // the source's, for the view format a change of the optics asks for
   bool still_;                   // a photo: ← and → step through the playlist instead of seeking
   SubtitleControls* subtitles_;  // read by the decoder as it draws them; null: no subtitles
+  int subtitle_index_ = -1;      // in options_.subtitle_tracks; -1: none shown
   int screenshots_pending_ = 0;  // Ctrl+s pressed, taken after the next render
   std::size_t help_line_ = 0;    // the next line of the key help that h shows
   std::string message_;

@@ -18,9 +18,10 @@ namespace {
 // and the view's compositing untouched (GL, the tables and the frames composited ahead alike).
 std::function<void(StereoVideoFrame&)> subtitle_drawing(const PlayerOptions& options,
                                                         const SubtitleControls& controls) {
-  if (!options.subtitles) return {};
-  return [track = options.subtitles, &controls](StereoVideoFrame& frame) {
-    if (!controls.shown) return;
+  if (!options.subtitles && options.subtitle_tracks.empty()) return {};
+  return [&controls](StereoVideoFrame& frame) {
+    const std::shared_ptr<SubtitleTrack> track = controls.track.load();
+    if (!track || !controls.shown) return;
     const double parallax = controls.parallax_percent;
     const auto [width, height] = subtitle_canvas(frame);
     draw_subtitles(frame, track->render(frame.pts_s, width, height, frame.aspect), parallax);
@@ -90,7 +91,7 @@ PlaySession::PlaySession(Display& display_, Source& source_, const PlayerOptions
       queue(queue_capacity),
       decoder([this] { decode_loop(source, queue, subtitle_drawing(options, subtitles)); }),
       commands(state, display, compositor, queue, sound, scheduler, options, info.duration_s, info.view, info.still,
-               options.subtitles ? &subtitles : nullptr),
+               options.subtitles || !options.subtitle_tracks.empty() ? &subtitles : nullptr),
       render_time(refresh_period),
       ticker(refresh_period) {}
 
@@ -163,7 +164,7 @@ PlayResult PlaySession::finish(std::int64_t composited_ahead) {
   else if (state.current)
     result.position_s = state.current->pts_s;
   result.eyes_swapped = state.swap_eyes;
-  if (options.subtitles) result.sub_parallax_percent = subtitles.parallax_percent;
+  if (options.subtitles || !options.subtitle_tracks.empty()) result.sub_parallax_percent = subtitles.parallax_percent;
   return result;
 }
 

@@ -110,7 +110,15 @@ std::string PlaySound::next_track(bool& changed) {
   changed = false;
   if (!audio_) return fmt::format("Audio: none ({})", description_);
   if (tracks_.size() < 2) return "Audio: the only track";
-  const int next = track_ % static_cast<int>(tracks_.size()) + 1;
+  return set_track(track_ % static_cast<int>(tracks_.size()) + 1, changed);
+}
+
+std::string PlaySound::set_track(int next, bool& changed) {
+  changed = false;
+  if (!audio_) return fmt::format("Audio: none ({})", description_);
+  if (next < 1 || next > static_cast<int>(tracks_.size()))
+    return fmt::format("Audio: no track {} (there are {})", next, tracks_.size());
+  if (next == track_) return fmt::format("Audio: track {} already plays", next);
   OpenedAudio opened = source_.open_audio({audio_->sample_rate(), audio_->channels(), next});
   if (!opened.stream) return fmt::format("Audio: track {} cannot be played ({})", next, opened.why_not);
   feeder_.reset();  // before the new one feeds the same device

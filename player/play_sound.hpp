@@ -46,6 +46,11 @@ class PlaySound {
   // Plays the input's next audio track (after the last, the first) from where the caller seeks it
   // to next; says what plays now, or why nothing changed. True in `changed` when the track did.
   std::string next_track(bool& changed);
+  // Plays track `number` (AudioTrack::number) instead, as next_track does.
+  std::string set_track(int number, bool& changed);
+  // The AudioTrack::number playing; 0 when there is no sound.
+  int track() const { return audio_ ? track_ : 0; }
+  int track_count() const { return static_cast<int>(tracks_.size()); }
 
   // The volume (0 to 130, 100 as decoded) by `delta`; what it is now, in words ("Volume: 54 %").
   std::string change_volume(double delta);

@@ -23,6 +23,7 @@
 #include "player/frame_scheduler.hpp"
 #include "player/key_bindings.hpp"
 #include "player/stepped_clock.hpp"
+#include "player/subtitle_choice.hpp"
 
 namespace nelf {
 
@@ -50,6 +51,10 @@ struct PlayerOptions {
   // sub_parallax_percent of the view width right of the right eye's.
   std::shared_ptr<SubtitleTrack> subtitles;
   double sub_parallax_percent = 0.0;
+  // What the subtitle track keys (j J) and the IPC's sid switch among (subtitle_tracks), the
+  // bitmaps of each laid out as `sub_stereo` says; empty: the subtitles there are cannot change.
+  std::vector<SubtitleTrackRef> subtitle_tracks;
+  SubtitleStereo sub_stereo = SubtitleStereo::flat;
   // Called after each new frame is rendered into the packed framebuffer, before present(); the
   // display's context is current (tests read the frame back here).
   std::function<void(const Display&, double pts_s)> after_render;

@@ -43,4 +43,25 @@ std::unique_ptr<SubtitleTrack> choose_subtitles(const std::string& input, const 
   return track;
 }
 
+std::vector<SubtitleTrackRef> subtitle_tracks(const std::string& input, const std::string& file) {
+  std::vector<std::string> files = file.empty() ? SubtitleTrack::beside(input) : std::vector<std::string>{file};
+  files.push_back(input);
+  std::vector<SubtitleTrackRef> tracks;
+  for (const std::string& path : files) {
+    const std::vector<std::string> streams = SubtitleTrack::streams(path);
+    for (std::size_t i = 0; i < streams.size(); ++i) tracks.push_back({path, static_cast<int>(i) + 1, streams[i]});
+  }
+  return tracks;
+}
+
+std::shared_ptr<SubtitleTrack> open_subtitle_track(const SubtitleTrackRef& ref, SubtitleStereo stereo) {
+  auto track = std::make_shared<SubtitleTrack>(ref.path, 0.0, SubtitleStreamChoice{ref.stream, {}});
+  try {
+    track->set_stereo(stereo);
+  } catch (const UserError&) {
+    // --sub-stereo is the bitmap tracks'; a text track switched to is laid out once, as always.
+  }
+  return track;
+}
+
 }  // namespace nelf

@@ -1,6 +1,7 @@
 // --input-ipc-server driven by socat, as mpv's scripts drive mpv: the replies are mpv's exact JSON,
 // seek, cycle pause and quit act on the player off screen, the socket is owner-only and removed at
-// exit, and a path that is not a socket is refused in one line.
+// exit, and a path that is not a socket is refused in one line. sid and aid switch a movie's
+// subtitle and audio tracks as mpv's remotes switch mpv's.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -8,6 +9,7 @@
 #include <string>
 #include <thread>
 
+#include "support/media.hpp"
 #include "support/test_support.hpp"
 
 namespace nelf::test {
@@ -70,6 +72,59 @@ TEST(IpcCli, SocatDrivesThePlayerWithMpvsJson) {
   ASSERT_TRUE(std::filesystem::exists(dir / "status")) << "quit did not end play";
   EXPECT_EQ(read_file(dir / "status"), "0\n") << read_file(dir / "err");
   EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(sock)));
+}
+
+// A movie with two audio tracks (eng, ger) and two subtitle tracks, played with a (dummy) sound
+// device so that there is a track to switch.
+TEST(IpcCli, SidAndAidSwitchTheTracksAsMpvsRemotesExpect) {
+  TempDir dir;
+  make_two_track_clip(dir / "audio.mp4", 30);
+  write_file(dir / "eng.srt", "1\n00:00:00,000 --> 00:00:30,000\nHELLO\n\n");
+  write_file(dir / "ger.srt", "1\n00:00:00,000 --> 00:00:30,000\nHALLO\n\n");
+  make_media(dir / "movie.mkv", "-i " + q(dir / "audio.mp4") + " -i " + q(dir / "eng.srt") + " -i " +
+                                    q(dir / "ger.srt") +
+                                    " -map 0 -map 1 -map 2 -c:v copy -c:a copy -c:s srt -metadata:s:s:0 language=eng "
+                                    "-metadata:s:s:1 language=ger");
+  const auto sock = dir / "nelf.sock";
+  const auto ask = [&](const std::string& json) {
+    return run_command("echo " + shell_quote(json) + " | socat -t 10 - UNIX-CONNECT:" + q(sock)).out;
+  };
+  const auto ok = std::string("{\"error\":\"success\",\"request_id\":0}\n");
+  const auto is = [](const std::string& data) {
+    return "{\"data\":" + data + ",\"error\":\"success\",\"request_id\":0}\n";
+  };
+  run_command("(env -u DISPLAY SDL_AUDIODRIVER=dummy LP_NUM_THREADS=2 " + std::string(NELF_BINARY) + " play " +
+              q(dir / "movie.mkv") + " --layout sbs --no-config --output offscreen --input-ipc-server " + q(sock) +
+              " 2>" + q(dir / "err") + "; echo $? >" + q(dir / "status") + ") >/dev/null 2>&1 </dev/null &");
+  for (int i = 0; i < 300 && !std::filesystem::is_socket(sock); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(std::filesystem::is_socket(sock)) << read_file(dir / "err");
+
+  EXPECT_EQ(ask(R"({"command": ["get_property", "sid"]})"), is("1"));
+  EXPECT_EQ(ask(R"({"command": ["set_property", "sid", 2]})"), ok);
+  EXPECT_EQ(ask(R"({"command": ["get_property", "sub"]})"), is("2"));
+  EXPECT_EQ(ask(R"({"command": ["set_property", "sid", "no"]})"), ok);
+  EXPECT_EQ(ask(R"({"command": ["get_property", "sid"]})"), is("false"));
+  EXPECT_EQ(ask(R"({"command": ["cycle", "sub"]})"), ok);  // off → the first
+  EXPECT_EQ(ask(R"({"command": ["get_property", "sid"]})"), is("1"));
+  EXPECT_EQ(ask(R"({"command": ["cycle", "sub", "down"]})"), ok);  // the first → off
+  EXPECT_EQ(ask(R"({"command": ["get_property", "sid"]})"), is("false"));
+  EXPECT_EQ(ask(R"({"command": ["set_property", "sid", 3]})"), "{\"error\":\"invalid parameter\",\"request_id\":0}\n");
+
+  EXPECT_EQ(ask(R"({"command": ["get_property", "aid"]})"), is("1"));
+  EXPECT_EQ(ask(R"({"command": ["set_property", "aid", 2]})"), ok);
+  EXPECT_EQ(ask(R"({"command": ["get_property", "audio"]})"), is("2"));
+  EXPECT_EQ(ask(R"({"command": ["cycle", "audio"]})"), ok);  // after the last, the first
+  EXPECT_EQ(ask(R"({"command": ["get_property", "aid"]})"), is("1"));
+  EXPECT_EQ(ask(R"({"command": ["set_property", "aid", 5]})"), "{\"error\":\"invalid parameter\",\"request_id\":0}\n");
+  EXPECT_EQ(ask(R"({"command": ["quit"]})"), ok);
+  for (int i = 0; i < 300 && !std::filesystem::exists(dir / "status"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(std::filesystem::exists(dir / "status")) << "quit did not end play";
+  EXPECT_EQ(read_file(dir / "status"), "0\n") << read_file(dir / "err");
+  const std::string err = read_file(dir / "err");
+  EXPECT_NE(err.find("nelf: Subtitles: track 2/2 (ger, subrip, movie.mkv)"), std::string::npos) << err;
+  EXPECT_NE(err.find("nelf: Audio: track 2/2 (ger, ac3, 5.1)"), std::string::npos) << err;
 }
 
 TEST(IpcCli, APathThatIsNotASocketIsRefused) {

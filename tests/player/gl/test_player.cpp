@@ -506,6 +506,38 @@ TEST_F(PlayerTest, ASubtitleCueShowsInBothEyesForItsTimeOnly) {
   EXPECT_GE(hidden, 40);  // v at the first frame: none of the cue's frames shows it
 }
 
+// j and J step through the subtitle tracks, off between the last and the first: j from the first of
+// two shows the second's words from then on, J the none.
+TEST_F(PlayerTest, JAndShiftJSwitchTheSubtitleTrackWhilePlaying) {
+  const auto clip = make_clip(dir_, 2);
+  test::write_file(dir_ / "one.srt", "1\n00:00:00,000 --> 00:00:02,000\nIIII\n\n");
+  test::write_file(dir_ / "two.srt", "1\n00:00:00,000 --> 00:00:02,000\nWWWWWWWW WWWWWWWW\n\n");
+  PlayerOptions options = silent_options();
+  const auto without = panels_played(clip, options);
+  options.on_screen_messages = false;  // "Subtitles: …" would be over the frames compared
+  options.subtitle_tracks = {{(dir_ / "one.srt").string(), 1, "no language, subrip"},
+                             {(dir_ / "two.srt").string(), 1, "no language, subrip"}};
+  const auto first = [&] { return std::make_shared<SubtitleTrack>((dir_ / "one.srt").string(), 0.0); };
+  options.subtitles = first();
+  const auto one = panels_played(clip, options);
+  options.subtitles = first();
+  const auto two = panels_played(clip, options, KeyPress::of(U'j'));
+  options.subtitles = first();
+  const auto off = panels_played(clip, options, KeyPress::of(U'J'));
+  int compared = 0;
+  for (const auto& [pts, eyes] : one) {
+    if (pts < 0.3 || !without.count(pts) || !two.count(pts) || !off.count(pts)) continue;
+    for (std::size_t e : {0u, 1u}) {
+      EXPECT_GT(differing(eyes[e], without.at(pts)[e], 0.05f), 20) << "track 1 not shown at " << pts;
+      EXPECT_GT(differing(two.at(pts)[e], eyes[e], 0.05f), 20) << "still track 1 after j at " << pts;
+      EXPECT_GT(differing(two.at(pts)[e], without.at(pts)[e], 0.05f), 20) << "no track 2 at " << pts;
+      EXPECT_EQ(differing(off.at(pts)[e], without.at(pts)[e], 0.05f), 0) << "subtitles after J at " << pts;
+    }
+    ++compared;
+  }
+  EXPECT_GE(compared, 30);
+}
+
 // On the tests' stepped clock the play loop's decisions follow from the timestamps and the refresh
 // rate alone: a 24 fps clip on the 60 Hz signal shows every frame, none repeated or dropped, each
 // at the refresh FrameScheduler chooses for it (the 2, 3, 2, 3 … cadence), and the frame log says
