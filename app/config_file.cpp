@@ -76,7 +76,7 @@ class ConfigReader {
       const std::optional<KeyPress> press = parse_key_name(name);
       if (!press)
         fail(node, fmt::format("unknown key name \"{}\" in [keys] (one character, or SPACE, LEFT, RIGHT, UP, DOWN, "
-                               "PGUP, PGDWN, ESC, ENTER, TAB, BS)",
+                               "PGUP, PGDWN, ESC, ENTER, TAB, BS, or Ctrl+ and a character)",
                                name));
       const std::optional<std::string> command = node.value_exact<std::string>();
       if (!command)

@@ -486,6 +486,11 @@ std::optional<KeyPress> parse_key_name(std::string_view name) {
     for (const std::string_view n : k.names)
       if (same_ignoring_case(name, n)) return KeyPress::of(k.key);
   if (const std::optional<char32_t> c = single_code_point(name); c && *c != U' ') return KeyPress::of(*c);
+  // "Ctrl+s", as key_name() and mpv write a character with Ctrl.
+  constexpr std::string_view kCtrl = "Ctrl+";
+  if (name.size() > kCtrl.size() && same_ignoring_case(name.substr(0, kCtrl.size()), kCtrl))
+    if (const std::optional<char32_t> c = single_code_point(name.substr(kCtrl.size())); c && *c != U' ')
+      return ctrl(*c);
   return std::nullopt;
 }
 

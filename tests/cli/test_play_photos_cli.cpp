@@ -237,6 +237,22 @@ TEST_F(PlayPhotos, CtrlSWritesThePackedFrameAsConvertDoes) {
   EXPECT_GT(flipped / n, 50 * same / n + 0.001);  // the panels are mostly black: small means
 }
 
+// A folder nothing can be written in (even by root: /proc) costs the screenshot, with a warning
+// that says why, and play goes on to its end.
+TEST_F(PlayPhotos, AScreenshotThatCannotBeWrittenIsAWarning) {
+  const fs::path chart = write_lavfi_still(dir_, "chart.png", "testsrc2=s=256x72");
+  write_file(dir_ / "keys", "\x13q");
+  const auto r = run_command("cd /proc && timeout 120 env -u DISPLAY LP_NUM_THREADS=2 XDG_STATE_HOME=" + q(state_) +
+                             " " + NELF_BINARY + " play " + q(chart) + " --layout sbs --profile " + q(profile_) +
+                             " --output offscreen --no-audio < " + q(dir_ / "keys"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto warning = r.err.find("nelf: warning: no screenshot: ");
+  ASSERT_NE(warning, std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nelf-shot0001.png", warning), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("nelf: screenshot "), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists("/proc/nelf-shot0001.png"));
+}
+
 // An MPO (two JPEGs) and a JPS (right view first) read alike in probe and play: probe used to see
 // an MPO's first JPEG only, as 2D.
 TEST_F(PlayPhotos, MpoAndJpsReadAlikeInProbeAndPlay) {

@@ -104,8 +104,14 @@ TEST(KeyBindings, KeyNamesAreMpvsAndOneCharacter) {
   EXPECT_EQ(parse_key_name("BS")->named, KeyPress::Named::backspace);
   EXPECT_EQ(parse_key_name("x")->character, U'x');
   EXPECT_EQ(parse_key_name("+")->character, U'+');
-  EXPECT_EQ(parse_key_name("\xc3\xa9")->character, U'\u00e9');  // é
-  for (const char* bad : {"", "xy", "Ctrl+x", " ", "\x01", "\xc3"}) EXPECT_EQ(parse_key_name(bad), std::nullopt) << bad;
+  EXPECT_EQ(parse_key_name("\xc3\xa9")->character, U'\u00e9');      // é
+  const std::optional<KeyPress> ctrl_s = parse_key_name("ctrl+s");  // as key_name() writes it, any case
+  ASSERT_TRUE(ctrl_s);
+  EXPECT_TRUE(ctrl_s->ctrl);
+  EXPECT_EQ(ctrl_s->character, U's');
+  EXPECT_EQ(key_name(*ctrl_s), "Ctrl+s");
+  for (const char* bad : {"", "xy", "Ctrl+", "Ctrl+xy", "Ctrl+ ", " ", "\x01", "\xc3"})
+    EXPECT_EQ(parse_key_name(bad), std::nullopt) << bad;
   EXPECT_EQ(key_name(*parse_key_name("\xc3\xa9")), "\xc3\xa9");
   EXPECT_EQ(key_name(KeyPress::of(KeyPress::Named::escape)), "Esc");
 }
