@@ -89,9 +89,11 @@ class FrameCompositor {
   std::array<int, 2> wanted_block(int width, int height, double aspect) const;
   // The same as the view format a source of `view`s negotiates (Source::negotiate): views as the
   // prefilter's block means where the input allows (swscale makes them while converting from
-  // YUV), far less to convert, upload and composite per frame. It follows the optics.
-  ViewFormat wanted_view_format(const ViewGeometry& view) const {
-    return {wanted_block(view.width, view.height, view.aspect)};
+  // YUV), far less to convert, upload and composite per frame. It follows the optics. For an
+  // 8-bit output (`output_bits`: a display, an 8-bit file), 8-bit views, which the CPU composite
+  // tables take.
+  ViewFormat wanted_view_format(const ViewGeometry& view, int output_bits = 8) const {
+    return {wanted_block(view.width, view.height, view.aspect), output_bits > 8 ? 16 : 8};
   }
 
   // New optics (the live keys). Throws, keeping the current profile, when `profile` is not

@@ -23,9 +23,14 @@ struct ViewGeometry {
 
 // How the views of a stream travel: each delivered pixel the mean of block[0]×block[1] pixels of
 // the view ({1, 1}: whole views). Asked for once per stream, and again when the optics change;
-// every frame carries the format it was made in (StereoVideoFrame::block).
+// every frame carries the format it was made in (StereoVideoFrame::block). `max_bits`: the deepest
+// views the consumer wants; 8 for an 8-bit output (a display, an 8-bit file), where a 10-bit
+// source's block means come as 8 bits, ordered-dithered, which the CPU composite tables take (a
+// source that cannot still delivers 16).
 struct ViewFormat {
-  std::array<int, 2> block{1, 1};
+  ViewFormat(std::array<int, 2> block_size = {1, 1}, int deepest = 16) : block(block_size), max_bits(deepest) {}
+  std::array<int, 2> block;
+  int max_bits;
   bool operator==(const ViewFormat&) const = default;
 };
 

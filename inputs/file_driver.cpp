@@ -205,7 +205,7 @@ class FileFrameSource final : public Source {
       if (!whole) wanted.push_back({right.x, right.y, right.width, right.height, block[0], block[1]});
     }
     try {
-      if (!source_.reduce_regions(std::move(wanted))) {
+      if (!source_.reduce_regions(std::move(wanted), format.max_bits)) {
         block = {1, 1};
         source_.reduce_regions({});  // whole frames always work
       }
@@ -214,7 +214,7 @@ class FileFrameSource final : public Source {
       throw UserError(e.what(), 1);
     }
     block_ = block;
-    return {block_};
+    return {block_, format.max_bits};
   }
   std::int64_t lost_frames() const override {
     return source_.stats().problems() + (right_ ? right_->stats().problems() : 0);

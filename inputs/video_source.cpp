@@ -91,6 +91,7 @@ struct VideoSource::Impl {
   SwsContextPtr sws;
   // reduce_regions(): the regions, and a converter for their size (one size for all of them).
   std::vector<ReducedRegion> regions;
+  int reduce_max_bits = 16;
   SwsContextPtr reduce_sws;
   int reduce_format = -1, reduce_colorspace = -1, reduce_full_range = -1;
   // What `sws` was built for; a change mid-stream (resolution switch) rebuilds it.
@@ -402,6 +403,37 @@ struct VideoSource::Impl {
       out.bits = 8;
       return;
     }
+    const AVPixFmtDescriptor* desc = av_pix_fmt_desc_get(source_format);
+    if (reduce_max_bits <= 8 && desc && desc->nb_components == 3 && desc->log2_chroma_w == 1 &&
+        desc->log2_chroma_h == 1 && (desc->flags & (AV_PIX_FMT_FLAG_BE | AV_PIX_FMT_FLAG_RGB)) == 0 &&
+        desc->comp[0].depth > 8 && desc->comp[0].step == 2 && desc->comp[0].shift == 0 &&
+        yuv420_block_means_supported(size.block_x, size.block_y)) {
+      // 10-bit (or deeper) 4:2:0 for an 8-bit output: the same block means, dithered to 8 bits,
+      // so that the CPU composite tables take them (play keeps pace with a 10-bit movie).
+      const YuvToRgb matrix = yuv_to_rgb_from_sws(sws_getCoefficients(colorspace), full_range);
+      const auto plane = [&](int i, int x, int y) {
+        return reinterpret_cast<const std::uint16_t*>(decoded.data[i] +
+                                                      static_cast<std::ptrdiff_t>(y) * decoded.linesize[i]) +
+               x;
+      };
+      for (const ReducedRegion& r : regions) {
+        if (r.x + r.width > decoded.width || r.y + r.height > decoded.height)
+          fail(fmt::format("the frame size changed mid-stream ({}x{})", decoded.width, decoded.height));
+        const Yuv420Planes16 planes{.y = plane(0, r.x, r.y),
+                                    .u = plane(1, r.x / 2, r.y / 2),
+                                    .v = plane(2, r.x / 2, r.y / 2),
+                                    .y_stride = decoded.linesize[0] / 2,
+                                    .u_stride = decoded.linesize[1] / 2,
+                                    .v_stride = decoded.linesize[2] / 2,
+                                    .bits = desc->comp[0].depth};
+        std::vector<std::uint8_t> pixels(static_cast<std::size_t>(out_w) * static_cast<std::size_t>(out_h) * 4);
+        yuv420_block_means(planes, r.width, r.height, r.block_x, r.block_y, matrix, pixels.data(),
+                           static_cast<std::size_t>(out_w) * 4);
+        out.reduced.push_back(std::move(pixels));
+      }
+      out.bits = 8;
+      return;
+    }
     if (!reduce_sws || reduce_format != source_format || reduce_colorspace != colorspace ||
         reduce_full_range != static_cast<int>(full_range)) {
       // SWS_AREA at a whole-number ratio weighs the pixels of each block equally (the prefilter's
@@ -609,13 +641,14 @@ std::optional<VideoFrame> VideoSource::next_frame() {
 }
 const DecodeStats& VideoSource::stats() const { return impl_->stats; }
 
-bool VideoSource::reduce_regions(std::vector<ReducedRegion> regions) {
+bool VideoSource::reduce_regions(std::vector<ReducedRegion> regions, int max_bits) {
   Impl& m = *impl_;
   if (!regions.empty()) {
     if (m.last->buf[0] == nullptr) return false;  // nothing decoded yet to check the format against
     if (!m.can_reduce(*m.last, regions)) return false;
   }
   m.regions = std::move(regions);
+  m.reduce_max_bits = max_bits;
   return true;
 }
 

@@ -140,8 +140,10 @@ class VideoSource {
   // frame is never made, which is most of the cost of a 1080p frame on a CPU. Returns false, and
   // changes nothing, when the stream cannot be delivered so: rotation metadata, a region off the
   // chroma grid or not a whole number of blocks, or a pixel format that cannot be cropped.
-  // An empty list returns to whole frames.
-  bool reduce_regions(std::vector<ReducedRegion> regions);
+  // An empty list returns to whole frames. `max_bits` 8: deeper 4:2:0 (10-bit video) is averaged
+  // to 8-bit RGBA, ordered-dithered (yuv_block_means.hpp), for an 8-bit output; otherwise to
+  // 16 bits. What the frames then hold, they say (VideoFrame::bits).
+  bool reduce_regions(std::vector<ReducedRegion> regions, int max_bits = 16);
   // The frame next_frame() returned last, converted again as now set (e.g. after reduce_regions).
   // nullopt before the first frame.
   std::optional<VideoFrame> convert_last();

@@ -36,4 +36,20 @@ bool yuv420_block_means_supported(int block_x, int block_y);
 void yuv420_block_means(const Yuv420Planes& planes, int width, int height, int block_x, int block_y,
                         const YuvToRgb& matrix, std::uint8_t* out, std::size_t out_stride);
 
+// 4:2:0 planes of `bits` (9 to 16) a sample, as FFmpeg's native-endian yuv420p10 and the like
+// hold them.
+struct Yuv420Planes16 {
+  const std::uint16_t* y = nullptr;
+  const std::uint16_t* u = nullptr;
+  const std::uint16_t* v = nullptr;
+  std::ptrdiff_t y_stride = 0, u_stride = 0, v_stride = 0;  // samples a row
+  int bits = 10;
+};
+
+// yuv420_block_means of deeper samples, still to RGBA8 (an 8-bit output): the means are converted
+// at their full precision and rounded with a 4×4 ordered dither, so that what the bits below 8
+// held survives as a pattern the compositing's averaging smooths, instead of as banding.
+void yuv420_block_means(const Yuv420Planes16& planes, int width, int height, int block_x, int block_y,
+                        const YuvToRgb& matrix, std::uint8_t* out, std::size_t out_stride);
+
 }  // namespace nelf

@@ -1,5 +1,6 @@
 // inputs/yuv_block_means: block means of 8-bit 4:2:0 straight to RGBA8, against swscale's area
-// scaler (what VideoSource used before, and still uses for other formats) and against exact colours.
+// scaler (what VideoSource used before, and still uses for other formats) and against exact colours;
+// of 10-bit 4:2:0 to dithered RGBA8, against the 8-bit means and the exact mean.
 #include <gtest/gtest.h>
 
 extern "C" {
@@ -7,6 +8,7 @@ extern "C" {
 #include <libswscale/swscale.h>
 }
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -146,6 +148,60 @@ TEST(YuvBlockMeans, EachBlockIsItsOwnMean) {
   EXPECT_TRUE(yuv420_block_means_supported(2, 4));
   EXPECT_FALSE(yuv420_block_means_supported(3, 4));
   EXPECT_FALSE(yuv420_block_means_supported(1, 2));
+}
+
+// The 10-bit samples of `f` (8-bit values times 4, plus `extra` quarter codes on luma).
+struct Frame420Deep {
+  int width, height;
+  std::vector<std::uint16_t> y, u, v;
+  Frame420Deep(const Frame420& f, int extra)
+      : width(f.width), height(f.height), y(f.y.size()), u(f.u.size()), v(f.v.size()) {
+    for (std::size_t i = 0; i < y.size(); ++i) y[i] = static_cast<std::uint16_t>(f.y[i] * 4 + extra);
+    for (std::size_t i = 0; i < u.size(); ++i) u[i] = static_cast<std::uint16_t>(f.u[i] * 4);
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<std::uint16_t>(f.v[i] * 4);
+  }
+  std::vector<std::uint8_t> block_means(int bx, int by) const {
+    const int out_w = width / bx, out_h = height / by;
+    std::vector<std::uint8_t> out(static_cast<std::size_t>(out_w) * out_h * 4);
+    const Yuv420Planes16 planes{.y = y.data(),
+                                .u = u.data(),
+                                .v = v.data(),
+                                .y_stride = width,
+                                .u_stride = width / 2,
+                                .v_stride = width / 2,
+                                .bits = 10};
+    yuv420_block_means(planes, width, height, bx, by, yuv_to_rgb_from_sws(sws_getCoefficients(SWS_CS_ITU709), false),
+                       out.data(), static_cast<std::size_t>(out_w) * 4);
+    return out;
+  }
+};
+
+TEST(YuvBlockMeans, TenBitMeansAreTheEightBitOnesDitheredWithinACode) {
+  const Frame420 f = test_frame(2 * 64, 4 * 32, 3u);
+  const auto eight = with_block_means(f, 2, 4, SWS_CS_ITU709, false);
+  const auto ten = Frame420Deep(f, 0).block_means(2, 4);
+  ASSERT_EQ(ten.size(), eight.size());
+  for (std::size_t i = 0; i < ten.size(); ++i) ASSERT_LE(std::abs(int(ten[i]) - int(eight[i])), 1) << i;
+}
+
+TEST(YuvBlockMeans, TenBitPrecisionSurvivesAsDither) {
+  // Flat grey a quarter of a code above 8-bit Y = 128: rounding alone would give one value
+  // everywhere; the dither's 4×4 pattern averages to the exact colour.
+  Frame420 flat(64, 64);
+  std::fill(flat.y.begin(), flat.y.end(), std::uint8_t{128});
+  std::fill(flat.u.begin(), flat.u.end(), std::uint8_t{128});
+  std::fill(flat.v.begin(), flat.v.end(), std::uint8_t{128});
+  const double exact = (128.25 - 16.0) * 255.0 / 219.0;  // limited range grey, in 8-bit RGB codes
+  const auto out = Frame420Deep(flat, 1).block_means(2, 2);
+  double sum = 0;
+  int lowest = 255, highest = 0;
+  for (std::size_t i = 0; i < out.size(); i += 4) {
+    sum += out[i];
+    lowest = std::min(lowest, int(out[i]));
+    highest = std::max(highest, int(out[i]));
+  }
+  EXPECT_NEAR(sum / (out.size() / 4), exact, 0.07);
+  EXPECT_EQ(highest - lowest, 1);  // two neighbouring codes, in the pattern
 }
 
 }  // namespace

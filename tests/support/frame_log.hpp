@@ -14,6 +14,7 @@ struct LogRow {
   std::string event;
   double pts = 0, clock = 0;  // pts -1: the row has none
   std::string audio_clock;
+  bool ahead = false;  // shown as composited ahead on the CPU tables' worker
 };
 
 inline std::vector<LogRow> read_log(const std::filesystem::path& path) {
@@ -28,7 +29,7 @@ inline std::vector<LogRow> read_log(const std::filesystem::path& path) {
     std::string field;
     while (std::getline(s, field, ',')) f.push_back(field);
     if (f.size() < 5) continue;
-    rows.push_back({f[1], f[2].empty() ? -1 : std::stod(f[2]), std::stod(f[3]), f[4]});
+    rows.push_back({f[1], f[2].empty() ? -1 : std::stod(f[2]), std::stod(f[3]), f[4], f.size() > 12 && f[12] == "1"});
   }
   return rows;
 }
