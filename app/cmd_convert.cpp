@@ -132,7 +132,18 @@ void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
   r.compositor = common.compositor;
   r.profile = std::move(common.profile);
   r.signal = common.signal;
-  r.encoder.codec = args.codec.value_or("h264");
+  // 8 bits plays everywhere (10-bit sources are dithered to it); --bits 10 keeps 10, as HEVC Main 10
+  // unless --codec says otherwise. Image files take 8 or 16.
+  const bool image_output = is_image_sequence_pattern(args.output) || is_image_file_name(args.output);
+  if (!is_raw_output(args.output)) {
+    if (image_output && args.bits != 8 && args.bits != 16)
+      throw UserError(fmt::format("--bits {}: 8 or 16 for {}", args.bits, args.output), 2);
+    if (!image_output && args.bits != 8 && args.bits != 10)
+      throw UserError(fmt::format("--bits {}: 8 (plays everywhere) or 10 (HEVC Main 10) for a video file", args.bits),
+                      2);
+  }
+  r.encoder.bits = args.bits;
+  r.encoder.codec = args.codec.value_or(args.bits == 10 && !image_output ? "hevc" : "h264");
   r.encoder.crf = args.crf;
   r.encoder.overwrite = args.overwrite;
   r.encoder.audio = !args.no_audio;
@@ -386,7 +397,9 @@ void add_convert_command(CLI::App& app) {
                   "Output: a video file, an image (.png, .tif, .exr, .jpg; of a video: the frame at --start) or an "
                   "image sequence pattern (frames_%05d.png)")
       ->required();
-  cmd->add_option("--bits", args->bits, "Bits per channel of the output file: 8, or 16 for .png/.tif")
+  cmd->add_option("--bits", args->bits,
+                  "Bits per channel of the output file: 8 (the default; 10-bit video is dithered to it), 10 for a "
+                  "video file (HEVC Main 10 unless --codec says otherwise), or 16 for .png/.tif")
       ->capture_default_str();
   cmd->add_flag("-y,--overwrite", args->overwrite, "Replace the output file if it exists");
   cmd->add_option("--codec", args->codec, "Video: h264 (default), hevc, ffv1 or any FFmpeg video encoder");

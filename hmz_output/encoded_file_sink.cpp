@@ -24,8 +24,7 @@ class EncodedFileSink final : public FrameSink {
         carried_(std::move(r.carried)),
         audio_(carried_ ? nullptr : std::move(r.audio)),
         end_s_(r.duration_s) {
-    EncoderSettings settings = r.encoder;
-    settings.bits = r.bits;
+    EncoderSettings settings = r.encoder;  // its bits: the file's (--bits), whatever the frames'
     settings.carried_end_s = r.duration_s;
     const AVRational rate = av_d2q(r.frame_rate, 100000);
     try {

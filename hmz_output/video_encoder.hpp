@@ -24,7 +24,8 @@ struct EncoderSettings {
   std::string preset = "medium";
   bool overwrite = false;  // -y
   bool audio = true;       // carry the source's audio streams
-  int bits = 8;            // bit depth to keep: 10-bit sources keep 10 bits where the codec allows
+  // The file's bits a channel: 8 (what plays everywhere), or more: 10 where the codec allows.
+  int bits = 8;
   // --duration: the carried chapters end there at the latest (they come at output time).
   std::optional<double> carried_end_s;
 };

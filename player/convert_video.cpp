@@ -126,9 +126,11 @@ void convert_video(const VideoConvertRequest& r) {
   if (r.burn_subs && !subtitles)
     subtitles = choose_subtitles(r.input, r.burn_subs->file, r.start_s.value_or(0.0), true, r.quiet,
                                  r.burn_subs->stream, r.burn_subs->stereo);
-  // Views arrive as the prefilter's block means when the input allows (render_eye_reduced).
+  // Views arrive as the prefilter's block means when the input allows (render_eye_reduced); for an
+  // 8-bit output a 10-bit source's means come dithered to 8 bits, which the CPU tables composite.
   const ViewGeometry view = source->info().view;
-  source->negotiate({stereo_prefilter_block(r.profile, r.compositor, view.width, view.height, view.aspect)});
+  source->negotiate({stereo_prefilter_block(r.profile, r.compositor, view.width, view.height, view.aspect),
+                     r.encoder.bits > 8 ? 16 : 8});
 
   // The first frame fixes the view size and depth for the whole run.
   auto first = source->next();

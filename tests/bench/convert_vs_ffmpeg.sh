@@ -5,17 +5,20 @@
 # (GL, llvmpipe without a GPU), frame packing and read-back. Not run by ctest; results go to
 # docs/PERFORMANCE.md.
 #
-# usage: tests/bench/convert_vs_ffmpeg.sh [NELF] [SECONDS] [RUNS] [LAYOUT]
+# usage: tests/bench/convert_vs_ffmpeg.sh [NELF] [SECONDS] [RUNS] [LAYOUT] [DEPTH]
 #   NELF     the nelf binary (default build/nelf)
 #   SECONDS  clip length at 24 fps (default 5)
 #   RUNS     runs of each command; the median is reported (default 3)
 #   LAYOUT   half: a 1920x1080 half side-by-side clip, each eye squeezed to 960x1080 (what "a 1080p
 #            side-by-side movie" is; the default); full: 3840x1080, each eye 1920x1080
+#   DEPTH    8: the clip is 8-bit H.264 (the default); 10: 10-bit HEVC (Main 10), which both
+#            commands write as 8-bit H.264 (nelf's default for it, dithered)
 set -euo pipefail
 nelf=$(realpath "${1:-build/nelf}")
 seconds=${2:-5}
 runs=${3:-3}
 layout=${4:-half}
+depth=${5:-8}
 export LP_NUM_THREADS=${LP_NUM_THREADS:-$(nproc)}
 
 work=$(mktemp -d)
@@ -35,7 +38,8 @@ ffmpeg -nostdin -hide_banner -loglevel error -y \
   -f lavfi -i "testsrc2=s=1920x1080:r=24:d=$seconds,hue=h=180,scale=$eye" \
   -f lavfi -i "sine=frequency=440:sample_rate=48000:duration=$seconds" \
   -filter_complex "[0][1]hstack,setsar=1[v]" -map "[v]" -map 2:a \
-  -c:v libx264 -preset veryfast -crf 20 -pix_fmt yuv420p -c:a aac "$clip"
+  $(if [ "$depth" = 10 ]; then echo "-c:v libx265 -preset ultrafast -crf 20 -pix_fmt yuv420p10le -x265-params log-level=error"
+    else echo "-c:v libx264 -preset veryfast -crf 20 -pix_fmt yuv420p"; fi) -c:a aac "$clip"
 
 nelf_cmd() { "$nelf" convert "$clip" "$work/nelf.mkv" --profile hmz-t1 --quiet -y; }
 ffmpeg_cmd() {
@@ -72,7 +76,8 @@ frames=$(ffprobe -v error -count_packets -select_streams v:0 -show_entries strea
 size=$(ffprobe -v error -select_streams v:0 -show_entries stream=width,height -of csv=s=x:p=0 "$work/nelf.mkv")
 n=$(median "${nelf_times[@]}")
 f=$(median "${ffmpeg_times[@]}")
-echo "clip: ${seconds} s, $frame $layout sbs H.264 24 fps; output ${size}, ${frames} frames, libx264 medium crf 18"
+codec=$([ "$depth" = 10 ] && echo "10-bit HEVC" || echo "H.264")
+echo "clip: ${seconds} s, $frame $layout sbs $codec 24 fps; output ${size}, ${frames} frames, libx264 medium crf 18"
 printf 'nelf convert: %.2f s (%.1f fps)\n' "$n" "$(echo "$frames / $n" | bc -l)"
 printf 'ffmpeg      : %.2f s (%.1f fps)\n' "$f" "$(echo "$frames / $f" | bc -l)"
 printf 'ratio       : %.2fx (median of %d runs each)\n' "$(echo "$n / $f" | bc -l)" "$runs"

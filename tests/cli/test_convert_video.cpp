@@ -489,6 +489,47 @@ TEST(ConvertVideo, BadOutputsAndArguments) {
   EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"in.mkv", "small.toml", "taken.mkv"}));
 }
 
+// A 10-bit HEVC source becomes what plays everywhere by default, 8-bit H.264, its 10-bit block
+// means dithered to 8 bits (which the CPU composite tables take, as an 8-bit source's); --bits 10
+// writes HEVC Main 10; other depths are one line.
+TEST(ConvertVideo, TenBitSourcesBecomeEightBitH264UnlessBits10) {
+  TempDir dir;
+  const auto profile = small_profile(dir);
+  make_media(dir / "in.mkv", red_blue(320, 180, false, 6) +
+                                 " -c:v libx265 -preset ultrafast -pix_fmt yuv420p10le -x265-params log-level=error");
+  const auto stream = [&](const std::filesystem::path& file) {
+    return run_command(
+               "ffprobe -v error -select_streams v:0 -show_entries stream=codec_name,pix_fmt,profile -of "
+               "default=nw=1 " +
+               q(file))
+        .out;
+  };
+  ASSERT_NE(stream(dir / "in.mkv").find("pix_fmt=yuv420p10le"), std::string::npos);
+  const std::string head = "convert " + q(dir / "in.mkv") + " ";
+  const std::string tail = " --profile " + q(profile);
+  auto r = run_nelf(head + q(dir / "eight.mkv") + tail + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(stream(dir / "eight.mkv").find("codec_name=h264\nprofile=High\npix_fmt=yuv420p\n"), std::string::npos)
+      << stream(dir / "eight.mkv");
+  r = run_nelf(head + q(dir / "ten.mkv") + tail + " --quiet --bits 10");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(stream(dir / "ten.mkv").find("codec_name=hevc\nprofile=Main 10\npix_fmt=yuv420p10le\n"), std::string::npos)
+      << stream(dir / "ten.mkv");
+  // The two agree but for the dither and the codecs (colours within a few codes).
+  int w = 0, h = 0;
+  const auto size = run_command("ffprobe -v error -select_streams v:0 -show_entries stream=width,height -of csv=p=0 " +
+                                q(dir / "eight.mkv"));
+  ASSERT_EQ(std::sscanf(size.out.c_str(), "%d,%d", &w, &h), 2) << size.out;
+  const RgbFrame a = decode_frame(dir / "eight.mkv", w, h, 2), b = decode_frame(dir / "ten.mkv", w, h, 2);
+  ASSERT_EQ(a.bytes.size(), b.bytes.size());
+  double sum = 0;
+  for (std::size_t i = 0; i < a.bytes.size(); ++i)
+    sum += std::abs(int(static_cast<unsigned char>(a.bytes[i])) - int(static_cast<unsigned char>(b.bytes[i])));
+  EXPECT_LT(sum / static_cast<double>(a.bytes.size()), 3.0);
+  expect_clean_failure(dir, head + q(dir / "out.mkv") + tail + " --bits 12", 2,
+                       "--bits 12: 8 (plays everywhere) or 10");
+}
+
 // An output that is one of the inputs is refused before any work, -y or not, in one line with
 // status 2, and the input is left byte for byte as it was (ffmpeg: "Output same as Input"): by the
 // same name, another spelling of it, a symlink or hard link to it, the --right view, or a frame
