@@ -9,6 +9,7 @@
 #include <epoxy/gl.h>
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -32,6 +33,13 @@ struct DisplayOptions {
   // offscreen: the keys typed into a pipe or a file on stdin, one per refresh (a scripted session;
   // off when the input itself is read from stdin).
   bool keys_from_stdin = false;
+};
+
+// A line of text for a desktop preview window: `width`×`height` opaque RGBA8 pixels, row 0 the top.
+struct PreviewCaption {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;
+  bool empty() const { return rgba.empty(); }
 };
 
 class Display : public Sink {
@@ -64,6 +72,15 @@ class Display : public Sink {
   // 'f': switch between window and fullscreen where that means anything; returns a line for the
   // on-screen message (e.g. "fullscreen on HMZ-T1" or "fullscreen needs a monitor named …").
   virtual std::string toggle_fullscreen() { return "fullscreen not available on this output"; }
+
+  // The on-screen message, shown flat over a desktop preview window: there the packed frame's
+  // elemental images make the copy drawn into the views (in focus through the lenses) a pattern of
+  // tiny ones that no one can read. Bottom centre, scaled to 1/16 of the window's height; empty:
+  // none. A display that is the HMD's signal (fullscreen, kms, quad-buffer, offscreen) shows only
+  // the views' copy, so it keeps no caption.
+  virtual void set_preview_caption(PreviewCaption caption) { (void)caption; }
+  // Whether set_preview_caption() shows anything (a window, fullscreen or not: `f` switches).
+  virtual bool takes_preview_caption() const { return false; }
 
   // One line for logs, e.g. "window 1280x1470 on :99 (llvmpipe, no vsync)" or
   // "KMS HDMI-A-1 1280x1470@60Hz 3D frame packing".

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -54,13 +55,46 @@ class PackedWindowDisplay final : public glfw::WindowDisplay {
   void draw_to_window(int fb_width, int fb_height) override {
     glDrawBuffer(GL_BACK);
     blit_fitted(0, 0, options().packed[0], options().packed[1], fb_width, fb_height);
+    draw_caption(fb_width, fb_height);
   }
 
   std::string kind() const override {
     return glfwGetWindowMonitor(window()) != nullptr ? "fullscreen on " + monitor_name_ : std::string("window");
   }
 
+  bool takes_preview_caption() const override { return true; }
+  void set_preview_caption(PreviewCaption caption) override {
+    caption_ = std::move(caption);
+    caption_texture_ = {};
+    caption_fbo_ = {};
+    if (caption_.empty()) return;
+    caption_texture_ = gl::make_texture_2d(GL_RGBA8, caption_.width, caption_.height);
+    glTextureSubImage2D(caption_texture_.id(), 0, 0, 0, caption_.width, caption_.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                        caption_.rgba.data());
+    caption_fbo_ = gl::make_framebuffer(caption_texture_);
+    gl::check_error("uploading the preview caption");
+  }
+
+  // The caption over the picture, in a window only (fullscreen, the window is the HMD's signal).
+  void draw_caption(int fb_width, int fb_height) const {
+    if (caption_.empty() || glfwGetWindowMonitor(window()) != nullptr) return;
+    const double scale = std::max(1.0, fb_height / 16.0 / caption_.height);
+    int w = static_cast<int>(std::lround(caption_.width * scale));
+    int h = static_cast<int>(std::lround(caption_.height * scale));
+    if (w > fb_width * 0.95) {  // narrowed to fit, its aspect kept
+      h = static_cast<int>(std::lround(h * (fb_width * 0.95) / w));
+      w = static_cast<int>(std::lround(fb_width * 0.95));
+    }
+    const int x0 = (fb_width - w) / 2, y0 = fb_height / 12;  // GL's rows count from the bottom
+    // The caption's row 0 is its top: flipped on the way, as blit_fitted flips the packed frame.
+    glBlitNamedFramebuffer(caption_fbo_.id(), 0, 0, 0, caption_.width, caption_.height, x0, y0 + h, x0 + w, y0,
+                           GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  }
+
   std::string monitor_name_;
+  PreviewCaption caption_;
+  gl::Texture caption_texture_;
+  gl::Framebuffer caption_fbo_;
 };
 
 }  // namespace

@@ -48,6 +48,44 @@ void PlayCommands::expire_message() {
   }
 }
 
+void PlayCommands::update_preview_caption() {
+  if (!display_.takes_preview_caption()) return;
+  const FrameOverlays now = overlays();
+  if (now.message == caption_shown_.message && now.bar == caption_shown_.bar) return;
+  caption_shown_ = now;
+  if (now.message.empty()) {
+    display_.set_preview_caption({});
+    return;
+  }
+  if (!caption_label_) caption_label_ = std::make_unique<TextOverlay>();
+  caption_label_->set_text(now.message);
+  caption_label_->set_bar(now.bar);
+  // The label as a 1280×720 view gets it (cap height 36 px), cut to its box, over black.
+  constexpr int kWidth = 1280, kHeight = 720;
+  const Image cover = caption_label_->cover(kWidth, kHeight, 0.0);
+  int x0 = kWidth, y0 = kHeight, x1 = -1, y1 = -1;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      if (cover.data()[(static_cast<std::size_t>(y) * kWidth + x) * 4 + 3] > 0.f) {
+        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+  if (x1 < 0) {
+    display_.set_preview_caption({});
+    return;
+  }
+  PreviewCaption caption{x1 - x0 + 1, y1 - y0 + 1, {}};
+  caption.rgba.resize(static_cast<std::size_t>(caption.width) * caption.height * 4);
+  for (int y = 0; y < caption.height; ++y)
+    for (int x = 0; x < caption.width; ++x) {
+      const float* p = &cover.data()[(static_cast<std::size_t>(y0 + y) * kWidth + x0 + x) * 4];
+      std::uint8_t* q = &caption.rgba[(static_cast<std::size_t>(y) * caption.width + x) * 4];
+      for (int c = 0; c < 3; ++c)
+        q[c] = static_cast<std::uint8_t>(std::lround(std::clamp(p[c] * p[3], 0.f, 1.f) * 255.f));
+      q[3] = 255;
+    }
+  display_.set_preview_caption(std::move(caption));
+}
+
 void PlayCommands::show_progress() {
   state_.dirty = true;
   if (options_.on_screen_messages) progress_until_ = std::chrono::steady_clock::now() + std::chrono::seconds(2);

@@ -12,6 +12,7 @@
 
 #include "compositor/compositor.hpp"
 #include "compositor/frame_compositor.hpp"
+#include "compositor/overlays/text_overlay.hpp"
 #include "core/frames.hpp"
 #include "hmz_output/display.hpp"
 #include "inputs/source.hpp"
@@ -101,6 +102,9 @@ class PlayCommands {
   void say(std::string text);
   // Takes the message off the screen once its two seconds are up.
   void expire_message();
+  // The message (or the time line) as the display's preview caption, when it changed: flat over a
+  // desktop window, where the views' copy is too small to read (Display::set_preview_caption).
+  void update_preview_caption();
   // What the state asks to be drawn over the frame: the message (or the time line) with the seek
   // bar while it shows, the grid, the eyes swapped.
   FrameOverlays overlays() const;
@@ -135,6 +139,8 @@ class PlayCommands {
   int screenshots_pending_ = 0;  // Ctrl+s pressed, taken after the next render
   std::size_t help_line_ = 0;    // the next line of the key help that h shows
   std::string message_;
+  std::unique_ptr<TextOverlay> caption_label_;  // made on the first caption
+  FrameOverlays caption_shown_;                 // what the caption says now (its message and bar)
   std::chrono::steady_clock::time_point message_until_{};
   std::optional<std::chrono::steady_clock::time_point> progress_until_;
   bool keep_progress_ = false;  // key O

@@ -45,6 +45,7 @@ PlayResult play(Display& display, Source& source, const PlayerOptions& options, 
     }
     playback::Refresh step = playback::choose_frame(session);
     session.commands.expire_message();
+    session.commands.update_preview_caption();
     if (step.finished && !holds_still(session)) break;
     playback::present_frame(session, step);
     if (step.ahead) ++composited_ahead;

@@ -111,6 +111,34 @@ TEST_F(WindowDisplayTest, ABgraPackedFrameUploadedIntoThePackedTextureShowsItsCo
   EXPECT_EQ(screen.at(w / 2, h / 2), colours[3]);
 }
 
+// The preview caption: flat over the picture at the bottom centre, 1/16 of the window's height (a
+// 20-row caption there on the 1470-row window: scaled ×4.6), its top row at the top; gone again when
+// cleared.
+TEST_F(WindowDisplayTest, APreviewCaptionShowsFlatAtTheBottomCentreUntilCleared) {
+  auto display = open_window_display(frame_packed_options(), WindowMode::window);
+  EXPECT_TRUE(display->takes_preview_caption());
+  glClearNamedFramebufferfv(display->packed_framebuffer(), GL_COLOR, 0, std::array<GLfloat, 4>{0, 0, 0, 1}.data());
+  PreviewCaption caption{100, 20, std::vector<std::uint8_t>(100u * 20u * 4u, 255)};
+  for (int x = 0; x < 100; ++x) caption.rgba[static_cast<std::size_t>(x) * 4 + 1] = 0;  // top row magenta
+  display->set_preview_caption(caption);
+  display->present();
+  test::WindowCapture screen = read_window();
+  ASSERT_EQ(screen.height, 1470);
+  const int h = static_cast<int>(std::lround(1470 / 16.0)), w = static_cast<int>(std::lround(100 * 1470 / 16.0 / 20));
+  const int bottom = 1470 - 1470 / 12, top = bottom - h, left = (1280 - w) / 2;
+  EXPECT_EQ(screen.at(640, bottom - h / 2), white);
+  EXPECT_EQ(screen.at(left + 3, bottom - 3), white);
+  EXPECT_EQ(screen.at(left + w - 4, top + h / 2), white);
+  EXPECT_EQ(screen.at(640, top + 1), (Rgb{255, 0, 255}));  // row 0 on top
+  EXPECT_EQ(screen.at(left - 3, bottom - h / 2), black);
+  EXPECT_EQ(screen.at(640, bottom + 3), black);
+  EXPECT_EQ(screen.at(640, top - 3), black);
+  display->set_preview_caption({});
+  display->present();
+  screen = read_window();
+  EXPECT_EQ(screen.at(640, bottom - h / 2), black);
+}
+
 TEST_F(WindowDisplayTest, ScalesToFitAResizedWindowWithBlackBars) {
   auto display = open_window_display(frame_packed_options(), WindowMode::window);
   GLFWwindow* window = glfwGetCurrentContext();

@@ -57,6 +57,52 @@ TEST_F(PlayerWindowTest, ClosingTheWindowEndsPlaybackCleanly) {
   EXPECT_EQ(result.counters.shown, 3);
 }
 
+// An on-screen message is also a flat caption over the preview window (bright text on a dark box
+// across its bottom centre), where the copies drawn into the views are too small to read.
+TEST_F(PlayerWindowTest, AMessageIsACaptionOverThePreviewWindowOnly) {
+  const auto clip = make_clip(dir_);
+  std::vector<test::WindowCapture> windows;
+  int packed_white_below = 0;
+  const auto played = [&](const std::string& announce) {
+    PlayerOptions options = silent_options();
+    options.announce = announce;
+    auto display = open_display(options);
+    int rendered = 0;
+    options.after_render = [&](const Display& d, double) {
+      if (++rendered != 3) return;
+      windows.push_back(test::capture_window(glfwGetCurrentContext()));  // frame 2, as presented
+      const auto [w, h] = d.packed_size();
+      const Image below = read_back(d.packed_framebuffer(), 0, h * 5 / 6, w, h - h * 5 / 6);
+      for (std::size_t i = 0; i < static_cast<std::size_t>(below.width()) * below.height(); ++i)
+        packed_white_below += below.data()[i * 4] > 0.8f && below.data()[i * 4 + 1] > 0.8f;
+    };
+    auto source = open_source(SourceRequest{clip.string(), "", std::nullopt, false, std::nullopt, true, false});
+    EXPECT_EQ(play(*display, *source, options).end, PlayEnd::end_of_file);
+  };
+  played("");
+  played("PREVIEW CAPTION");
+  ASSERT_EQ(windows.size(), 2u);
+  const test::WindowCapture &plain = windows[0], &captioned = windows[1];
+  ASSERT_EQ(plain.width, captioned.width);
+  ASSERT_EQ(plain.height, captioned.height);
+  // Near-white pixels in the middle half of the window's width, rows [y0, y1).
+  const auto white_pixels = [](const test::WindowCapture& window, int y0, int y1) {
+    int n = 0;
+    for (int y = y0; y < y1; ++y)
+      for (int x = window.width / 4; x < window.width * 3 / 4; ++x) {
+        const auto c = window.at(x, y);
+        n += c[0] > 200 && c[1] > 200 && c[2] > 200;
+      }
+    return n;
+  };
+  // Below the panels the packed frame is black: there the caption's letters are the only white.
+  const int low = plain.height * 5 / 6;
+  EXPECT_EQ(white_pixels(plain, low, plain.height), 0);
+  EXPECT_GT(white_pixels(captioned, low, plain.height), 200);
+  // The packed frame itself (what the HMD is sent, what Ctrl+s saves) has no caption.
+  EXPECT_EQ(packed_white_below, 0);
+}
+
 // A stereo photo plays as its one frame (for --image-duration), read as convert reads it (the still driver): a JPS
 // (right view first) and an MPO (two JPEGs) both show the left view to the left eye, in the window too.
 TEST_F(PlayerWindowTest, AStereoPhotoShowsEachEyesView) {
