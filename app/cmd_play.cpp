@@ -80,6 +80,13 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
   const SourceInfo info = source->info();
 
   PlayerOptions options;
+  // A views screenshot decodes the frame on screen again from the file (not from a pipe or a capture).
+  if (!info.live && info.seekable && !reads_stdin(request.input))
+    options.reopen_input = [request] {
+      SourceRequest again = request;
+      again.quiet = true;
+      return open_source(again);
+    };
   options.profile = common.profile;
   options.signal = common.signal;
   options.compositor = common.compositor;

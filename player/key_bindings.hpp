@@ -40,6 +40,7 @@ enum class Command {
   subtitles_nearer,
   subtitles_farther,
   screenshot,
+  screenshot_views,
   volume_down,
   volume_up,
   mute,

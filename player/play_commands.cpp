@@ -14,6 +14,7 @@
 #include "core/user_error.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "inputs/test_patterns.hpp"
+#include "player/views_screenshot.hpp"
 
 namespace nelf::playback {
 
@@ -212,17 +213,46 @@ void PlayCommands::change_profile(const Profile& changed, const std::string& wha
   }
 }
 
+void PlayCommands::finish_screenshots() {
+  report_views_screenshot(true);
+  while (views_pending_ > 0 && state_.current) {  // asked for while another was being written
+    start_views_screenshot();
+    report_views_screenshot(true);
+  }
+}
+
+void PlayCommands::start_views_screenshot() {
+  --views_pending_;
+  ViewsShot shot{state_.current->pts_s, state_.swap_eyes, std::nullopt, options_.sub_stereo, 0.0};
+  if (subtitles_ && subtitles_->shown && subtitle_track() > 0) {
+    shot.subtitles = options_.subtitle_tracks[static_cast<std::size_t>(subtitle_index_)];
+    shot.sub_parallax_percent = subtitles_->parallax_percent;
+  }
+  views_job_ = std::async(std::launch::async, [shot, reopen = options_.reopen_input, frame = state_.current] {
+    return write_views_screenshot(shot, reopen, *frame);
+  });
+}
+
+void PlayCommands::report_views_screenshot(bool wait) {
+  if (!views_job_.valid()) return;
+  if (!wait && views_job_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+  try {
+    const std::string name = views_job_.get();
+    if (!options_.quiet) fmt::print(stderr, "nelf: screenshot {}\n", printable(name));
+    say(fmt::format("screenshot {}", name));
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "nelf: warning: no screenshot of the views: {}\n", printable(e.what()));
+    say(fmt::format("no screenshot of the views: {}", e.what()));
+  }
+}
+
 void PlayCommands::take_pending_screenshot() {
+  report_views_screenshot(false);
+  if (views_pending_ > 0 && state_.current && !views_job_.valid()) start_views_screenshot();
   if (screenshots_pending_ == 0 || !state_.current) return;  // nothing drawn yet: the next refresh
   --screenshots_pending_;
   try {
-    std::filesystem::path path;
-    std::error_code error;
-    for (int n = 1; n <= 9999 && path.empty(); ++n) {
-      std::filesystem::path candidate = fmt::format("nelf-shot{:04d}.png", n);
-      if (!std::filesystem::exists(candidate, error) && !error) path = std::move(candidate);
-    }
-    if (path.empty()) throw ImageWriteError("nelf-shot0001.png to nelf-shot9999.png are all taken");
+    const std::filesystem::path path = first_free_name("nelf-shot{:04d}.png");
     const auto [width, height] = display_.packed_size();
     // As the display shows it: the frame with its messages, the grid, the eyes as swapped.
     write_image_file(read_back(display_.packed_framebuffer(), 0, 0, width, height), path, {});
@@ -324,6 +354,9 @@ std::optional<PlayEnd> PlayCommands::apply(Command command) {
     }
     case Command::screenshot:
       ++screenshots_pending_;
+      break;
+    case Command::screenshot_views:
+      ++views_pending_;
       break;
     case Command::next_subtitle_track:
     case Command::previous_subtitle_track:

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstddef>
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
@@ -96,8 +97,11 @@ class PlayCommands {
   int audio_track_count() const { return sound_.track_count(); }
   bool set_audio_track(int number);
   // A screenshot asked for (Ctrl+s) is taken once a frame is on the display: the packed frame
-  // into the first free nelf-shotNNNN.png of the current folder. Called after each refresh's render.
+  // into the first free nelf-shotNNNN.png of the current folder; one of the views (Ctrl+v) is
+  // written by a worker (player/views_screenshot), said when done. Called after each refresh's render.
   void take_pending_screenshot();
+  // At the end of play: waits for a views screenshot still being written, and says how it went.
+  void finish_screenshots();
   // A message on screen for two seconds (when on-screen messages are on); the frame is redrawn.
   void say(std::string text);
   // Takes the message off the screen once its two seconds are up.
@@ -118,6 +122,10 @@ class PlayCommands {
   // The frames decoded ahead show what a key just changed (the subtitles, the audio track) as it
   // was: they are decoded again from the one on screen (a seek there).
   void decode_again_from_here();
+  // Says how the views screenshot being written went, once it is done (or now when `wait`).
+  void report_views_screenshot(bool wait);
+  // A views screenshot of the frame on screen, on a worker.
+  void start_views_screenshot();
   // The time line and the seek bar for two seconds (after a seek, key o).
   void show_progress();
   // Where playback is: the frame on screen, or where a seek goes.
@@ -132,12 +140,14 @@ class PlayCommands {
   FrameScheduler& scheduler_;
   const PlayerOptions& options_;
   std::optional<double> duration_s_;
-  ViewGeometry view_;            // the source's, for the view format a change of the optics asks for
-  bool still_;                   // a photo: ← and → step through the playlist instead of seeking
-  SubtitleControls* subtitles_;  // read by the decoder as it draws them; null: no subtitles
-  int subtitle_index_ = -1;      // in options_.subtitle_tracks; -1: none shown
-  int screenshots_pending_ = 0;  // Ctrl+s pressed, taken after the next render
-  std::size_t help_line_ = 0;    // the next line of the key help that h shows
+  ViewGeometry view_;                   // the source's, for the view format a change of the optics asks for
+  bool still_;                          // a photo: ← and → step through the playlist instead of seeking
+  SubtitleControls* subtitles_;         // read by the decoder as it draws them; null: no subtitles
+  int subtitle_index_ = -1;             // in options_.subtitle_tracks; -1: none shown
+  int screenshots_pending_ = 0;         // Ctrl+s pressed, taken after the next render
+  int views_pending_ = 0;               // Ctrl+v pressed
+  std::future<std::string> views_job_;  // the views being decoded again and written
+  std::size_t help_line_ = 0;           // the next line of the key help that h shows
   std::string message_;
   std::unique_ptr<TextOverlay> caption_label_;  // made on the first caption
   FrameOverlays caption_shown_;                 // what the caption says now (its message and bar)

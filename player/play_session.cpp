@@ -151,6 +151,7 @@ PlayResult PlaySession::finish(std::int64_t composited_ahead) {
   source.interrupt();
   queue.stop();
   decoder.join();
+  commands.finish_screenshots();
   PlayResult result;
   result.had_sound = sound.playing();
   result.sound = sound.description();

@@ -72,6 +72,9 @@ struct PlayerOptions {
   // previous file can go to.
   bool has_next = false;
   bool has_previous = false;
+  // Opens the input again, for a screenshot of the views (Ctrl+v), which decodes the frame on
+  // screen once more at full resolution; null (a live input, a pipe): the views as they are shown.
+  std::function<std::unique_ptr<Source>()> reopen_input;
   // Said on screen with the first frame ("resuming at 0:12:34", "2/5: photo.jps"); "" for none.
   std::string announce;
 };

@@ -237,11 +237,48 @@ TEST_F(PlayPhotos, CtrlSWritesThePackedFrameAsConvertDoes) {
   EXPECT_GT(flipped / n, 50 * same / n + 0.001);  // the panels are mostly black: small means
 }
 
-// A folder nothing can be written in (even by root: /proc) costs the screenshot, with a warning
-// that says why, and play goes on to its end.
+// Ctrl+v: the views of the frame on screen side by side at the source's height, each at its display
+// aspect (a half side-by-side movie's squeezed views widened again), with the subtitles, the eyes
+// as the s key left them; written by a worker, so play goes on meanwhile.
+TEST_F(PlayPhotos, CtrlVWritesTheViewsSideBySideWithTheSubtitles) {
+  // Half side by side: red left, blue right, each squeezed to 160x180 of a 320x180 frame.
+  make_media(dir_ / "movie.mkv",
+             two_colour_input(160, 180, false, 20, 10) + " -c:v libx264 -preset ultrafast -pix_fmt yuv420p");
+  write_file(dir_ / "movie.srt", "1\n00:00:00,000 --> 00:00:05,000\nHELLO WORLD\n\n");
+  const fs::path shots = dir_ / "shots";
+  fs::create_directories(shots);
+  write_file(dir_ / "keys", "\x16s\x16q");
+  const auto r =
+      run_command("cd " + q(shots) + " && timeout 120 env -u DISPLAY LP_NUM_THREADS=2 XDG_STATE_HOME=" + q(state_) +
+                  " " + NELF_BINARY + " play " + q(dir_ / "movie.mkv") + " --layout sbs-half --profile " + q(profile_) +
+                  " --output offscreen --no-audio < " + q(dir_ / "keys"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(in_order(r.err, {"nelf: screenshot nelf-views0001.png", "nelf: screenshot nelf-views0002.png"})) << r.err;
+  for (const auto& [name, left_red] : {std::pair{"nelf-views0001.png", true}, std::pair{"nelf-views0002.png", false}}) {
+    SCOPED_TRACE(name);
+    const ReadBack views = read_back(shots / name);
+    ASSERT_EQ(views.width, 640);  // two 320x180 views: 180 rows at 16:9
+    ASSERT_EQ(views.height, 180);
+    for (int half = 0; half < 2; ++half) {
+      double red = 0, blue = 0;
+      int letters = 0;
+      for (int y = 0; y < 180; ++y)
+        for (int x = half * 320; x < half * 320 + 320; ++x) {
+          red += views.at(x, y, 0), blue += views.at(x, y, 2);
+          letters += views.at(x, y, 1) > 0.5f && y > 120;  // neither red nor blue has green
+        }
+      const bool red_here = (half == 0) == left_red;
+      EXPECT_GT(red_here ? red : blue, 3 * (red_here ? blue : red)) << "half " << half;
+      EXPECT_GT(letters, 20) << "no subtitle in half " << half;
+    }
+  }
+}
+
+// A folder nothing can be written in (even by root: /proc) costs the screenshots (Ctrl+s, Ctrl+v),
+// each with a warning that says why, and play goes on to its end.
 TEST_F(PlayPhotos, AScreenshotThatCannotBeWrittenIsAWarning) {
   const fs::path chart = write_lavfi_still(dir_, "chart.png", "testsrc2=s=256x72");
-  write_file(dir_ / "keys", "\x13q");
+  write_file(dir_ / "keys", "\x13\x16q");
   const auto r = run_command("cd /proc && timeout 120 env -u DISPLAY LP_NUM_THREADS=2 XDG_STATE_HOME=" + q(state_) +
                              " " + NELF_BINARY + " play " + q(chart) + " --layout sbs --profile " + q(profile_) +
                              " --output offscreen --no-audio < " + q(dir_ / "keys"));
@@ -251,6 +288,10 @@ TEST_F(PlayPhotos, AScreenshotThatCannotBeWrittenIsAWarning) {
   EXPECT_NE(r.err.find("nelf-shot0001.png", warning), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("nelf: screenshot "), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists("/proc/nelf-shot0001.png"));
+  const auto views = r.err.find("nelf: warning: no screenshot of the views: ");
+  ASSERT_NE(views, std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nelf-views0001.png", views), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists("/proc/nelf-views0001.png"));
 }
 
 // An MPO (two JPEGs) and a JPS (right view first) read alike in probe and play: probe used to see
