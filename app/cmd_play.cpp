@@ -50,7 +50,8 @@ bool reads_stdin(const std::string& input) { return input == "-" || input == "pi
 // The display opens once the first entry has: a file that cannot be read is said before a window
 // appears (or instead of the error that there is no display).
 PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const std::function<Display&()>& display,
-                      SourceRequest request, const WatchLater& watch_later, std::size_t index, std::size_t count) {
+                      SourceRequest request, const WatchLater& watch_later, std::size_t index, std::size_t count,
+                      const std::shared_ptr<playback::IpcServer>& ipc) {
   // Before it opens: an entry that fails is then named after its number.
   if (count > 1 && !args.quiet) fmt::print(stderr, "nelf: {}/{}: {}\n", index + 1, count, printable(request.input));
   const std::string path_name = std::filesystem::path(request.input).filename().string();
@@ -101,7 +102,7 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
   options.log_frames = args.log_frames;
   options.quiet = args.quiet;
   options.key_rebindings = rebound_keys();
-  options.ipc_server = args.input_ipc_server;
+  options.ipc_server = ipc;
   options.media_path = request.input;
   options.image_duration_s = args.image_duration;
   options.has_previous = index > 0;
@@ -227,13 +228,16 @@ PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::
     return *display;
   };
 
+  // One socket for the whole playlist, before anything opens: a bad path stops play at once.
+  const std::shared_ptr<playback::IpcServer> ipc =
+      args.input_ipc_server.empty() ? nullptr : std::make_shared<playback::IpcServer>(args.input_ipc_server);
   PlayEnd end = PlayEnd::end_of_file;
   std::size_t played = 0;
   bool forward = true;
   for (std::size_t index = 0; index < entries.size();) {
     request.input = entries[index];
     try {
-      end = play_entry(args, common, open_display, request, watch_later, index, entries.size()).end;
+      end = play_entry(args, common, open_display, request, watch_later, index, entries.size(), ipc).end;
       ++played;
     } catch (const UserError& e) {
       // One file is the whole command: its error is play's. In a playlist it is skipped.

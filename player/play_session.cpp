@@ -78,7 +78,7 @@ PlaySession::PlaySession(Display& display_, Source& source_, const PlayerOptions
       compositor(options.profile, options.compositor, layout, display.context()),
       target(checked_target(display, compositor, layout, options)),
       log(options.log_frames),
-      ipc(options.ipc_server.empty() ? nullptr : std::make_unique<IpcServer>(options.ipc_server)),
+      ipc(options.ipc_server),
       sound(source, options),
       clock(paused_master_clock(sound, options)),
       refresh_period(1.0 / display.refresh_hz()),

@@ -60,7 +60,7 @@ struct PlaySession {
   FrameCompositor compositor;
   const GlPackedTarget target;  // made once the eyes are checked to fit it
   FrameLog log;
-  std::unique_ptr<IpcServer> ipc;  // --input-ipc-server, before the threads start: a bad path stops play at once
+  std::shared_ptr<IpcServer> ipc;  // --input-ipc-server (the playlist's), polled once a refresh
   PlaySound sound;
   PlaybackClock& clock;  // the master clock, paused until the first frame is on screen
   const double refresh_period;

@@ -21,6 +21,7 @@
 #include "inputs/subtitle_track.hpp"
 #include "optics/profile.hpp"
 #include "player/frame_scheduler.hpp"
+#include "player/ipc_server.hpp"
 #include "player/key_bindings.hpp"
 #include "player/stepped_clock.hpp"
 #include "player/subtitle_choice.hpp"
@@ -41,8 +42,10 @@ struct PlayerOptions {
   std::string log_frames;        // CSV of every refresh (diagnostics); "" = none
   bool quiet = false;            // no "playing …" / audio status lines on stderr (warnings still are)
   KeyRebindings key_rebindings;  // the configuration file's [keys]
-  std::string ipc_server;        // --input-ipc-server: mpv's JSON IPC on this socket; "" = none
-  std::string media_path;        // the input as given (the IPC's path and filename properties)
+  // --input-ipc-server: mpv's JSON IPC, listening for the whole playlist (its clients stay connected
+  // from one file to the next, as mpv's do); null: none.
+  std::shared_ptr<playback::IpcServer> ipc_server;
+  std::string media_path;  // the input as given (the IPC's path and filename properties)
   // Each key's change said on screen for 2 s. Off (tests): while a message shows, frames are
   // composited with GL (the text is drawn there), so without them the CPU path and its frames
   // composited ahead are seen right after a key.

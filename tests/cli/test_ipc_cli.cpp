@@ -127,6 +127,32 @@ TEST(IpcCli, SidAndAidSwitchTheTracksAsMpvsRemotesExpect) {
   EXPECT_NE(err.find("nelf: Audio: track 2/2 (ger, ac3, 5.1)"), std::string::npos) << err;
 }
 
+// One socket for the whole playlist, as mpv's: a client connected during the first file is answered
+// in the second on the same connection.
+TEST(IpcCli, AClientStaysConnectedFromOneFileOfThePlaylistToTheNext) {
+  TempDir dir;
+  const auto sock = dir / "nelf.sock";
+  run_command("(env -u DISPLAY LP_NUM_THREADS=2 " + std::string(NELF_BINARY) +
+              " play synthetic:duration=1 synthetic:duration=3 --no-config --output offscreen --no-audio "
+              "--input-ipc-server " +
+              q(sock) + " 2>" + q(dir / "err") + "; echo $? >" + q(dir / "status") + ") >/dev/null 2>&1 </dev/null &");
+  for (int i = 0; i < 300 && !std::filesystem::is_socket(sock); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(std::filesystem::is_socket(sock)) << read_file(dir / "err");
+  const std::string ask = R"({"command": ["get_property", "duration"]})";
+  // The second request once the second file is opening (its line is said before it plays).
+  const auto r =
+      run_command("(echo " + shell_quote(ask) + "; for i in $(seq 300); do grep -q '2/2:' " + q(dir / "err") +
+                  " && break; sleep 0.1; done; echo " + shell_quote(ask) + ") | socat -t 10 - UNIX-CONNECT:" + q(sock));
+  EXPECT_EQ(r.out,
+            "{\"data\":1.0,\"error\":\"success\",\"request_id\":0}\n"
+            "{\"data\":3.0,\"error\":\"success\",\"request_id\":0}\n")
+      << read_file(dir / "err");
+  for (int i = 0; i < 300 && !std::filesystem::exists(dir / "status"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_EQ(read_file(dir / "status"), "0\n") << read_file(dir / "err");
+}
+
 TEST(IpcCli, APathThatIsNotASocketIsRefused) {
   TempDir dir;
   write_file(dir / "notes.txt", "keep");
