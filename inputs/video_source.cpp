@@ -382,25 +382,29 @@ struct VideoSource::Impl {
     const ReducedRegion& size = regions.front();
     const int out_w = size.width / size.block_x, out_h = size.height / size.block_y;
     const AVPixelFormat target = bits_of(source_format) > 8 ? AV_PIX_FMT_RGBA64 : AV_PIX_FMT_RGBA;
-    if (source_format == AV_PIX_FMT_YUV420P && yuv420_block_means_supported(size.block_x, size.block_y)) {
-      // Most video: block means of 8-bit 4:2:0 without swscale (inputs/yuv_block_means.hpp).
+    // Each region's block means from its planes (`planes_of`), straight to 8-bit RGBA.
+    const auto means_of_regions = [&](const auto& planes_of) {
       const YuvToRgb matrix = yuv_to_rgb_from_sws(sws_getCoefficients(colorspace), full_range);
       for (const ReducedRegion& r : regions) {
         if (r.x + r.width > decoded.width || r.y + r.height > decoded.height)
           fail(fmt::format("the frame size changed mid-stream ({}x{})", decoded.width, decoded.height));
-        const Yuv420Planes planes{
-            .y = decoded.data[0] + static_cast<std::ptrdiff_t>(r.y) * decoded.linesize[0] + r.x,
-            .u = decoded.data[1] + static_cast<std::ptrdiff_t>(r.y / 2) * decoded.linesize[1] + r.x / 2,
-            .v = decoded.data[2] + static_cast<std::ptrdiff_t>(r.y / 2) * decoded.linesize[2] + r.x / 2,
-            .y_stride = decoded.linesize[0],
-            .u_stride = decoded.linesize[1],
-            .v_stride = decoded.linesize[2]};
         std::vector<std::uint8_t> pixels(static_cast<std::size_t>(out_w) * static_cast<std::size_t>(out_h) * 4);
-        yuv420_block_means(planes, r.width, r.height, r.block_x, r.block_y, matrix, pixels.data(),
+        yuv420_block_means(planes_of(r), r.width, r.height, r.block_x, r.block_y, matrix, pixels.data(),
                            static_cast<std::size_t>(out_w) * 4);
         out.reduced.push_back(std::move(pixels));
       }
       out.bits = 8;
+    };
+    if (source_format == AV_PIX_FMT_YUV420P && yuv420_block_means_supported(size.block_x, size.block_y)) {
+      // Most video: block means of 8-bit 4:2:0 without swscale (inputs/yuv_block_means.hpp).
+      means_of_regions([&](const ReducedRegion& r) {
+        return Yuv420Planes{.y = decoded.data[0] + static_cast<std::ptrdiff_t>(r.y) * decoded.linesize[0] + r.x,
+                            .u = decoded.data[1] + static_cast<std::ptrdiff_t>(r.y / 2) * decoded.linesize[1] + r.x / 2,
+                            .v = decoded.data[2] + static_cast<std::ptrdiff_t>(r.y / 2) * decoded.linesize[2] + r.x / 2,
+                            .y_stride = decoded.linesize[0],
+                            .u_stride = decoded.linesize[1],
+                            .v_stride = decoded.linesize[2]};
+      });
       return;
     }
     const AVPixFmtDescriptor* desc = av_pix_fmt_desc_get(source_format);
@@ -410,28 +414,20 @@ struct VideoSource::Impl {
         yuv420_block_means_supported(size.block_x, size.block_y)) {
       // 10-bit (or deeper) 4:2:0 for an 8-bit output: the same block means, dithered to 8 bits,
       // so that the CPU composite tables take them (play keeps pace with a 10-bit movie).
-      const YuvToRgb matrix = yuv_to_rgb_from_sws(sws_getCoefficients(colorspace), full_range);
       const auto plane = [&](int i, int x, int y) {
         return reinterpret_cast<const std::uint16_t*>(decoded.data[i] +
                                                       static_cast<std::ptrdiff_t>(y) * decoded.linesize[i]) +
                x;
       };
-      for (const ReducedRegion& r : regions) {
-        if (r.x + r.width > decoded.width || r.y + r.height > decoded.height)
-          fail(fmt::format("the frame size changed mid-stream ({}x{})", decoded.width, decoded.height));
-        const Yuv420Planes16 planes{.y = plane(0, r.x, r.y),
-                                    .u = plane(1, r.x / 2, r.y / 2),
-                                    .v = plane(2, r.x / 2, r.y / 2),
-                                    .y_stride = decoded.linesize[0] / 2,
-                                    .u_stride = decoded.linesize[1] / 2,
-                                    .v_stride = decoded.linesize[2] / 2,
-                                    .bits = desc->comp[0].depth};
-        std::vector<std::uint8_t> pixels(static_cast<std::size_t>(out_w) * static_cast<std::size_t>(out_h) * 4);
-        yuv420_block_means(planes, r.width, r.height, r.block_x, r.block_y, matrix, pixels.data(),
-                           static_cast<std::size_t>(out_w) * 4);
-        out.reduced.push_back(std::move(pixels));
-      }
-      out.bits = 8;
+      means_of_regions([&](const ReducedRegion& r) {
+        return Yuv420Planes16{.y = plane(0, r.x, r.y),
+                              .u = plane(1, r.x / 2, r.y / 2),
+                              .v = plane(2, r.x / 2, r.y / 2),
+                              .y_stride = decoded.linesize[0] / 2,
+                              .u_stride = decoded.linesize[1] / 2,
+                              .v_stride = decoded.linesize[2] / 2,
+                              .bits = desc->comp[0].depth};
+      });
       return;
     }
     if (!reduce_sws || reduce_format != source_format || reduce_colorspace != colorspace ||

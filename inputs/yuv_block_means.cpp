@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -159,16 +160,31 @@ void convert_row(const std::int32_t* y_sum, const std::int32_t* u_sum, const std
 
 }  // namespace
 
-void yuv420_block_means(const Yuv420Planes& planes, int width, int height, int block_x, int block_y,
-                        const YuvToRgb& matrix, std::uint8_t* out, std::size_t out_stride) {
+namespace {
+
+// Both depths: each output row's block sums (16 bits a column for 8-bit samples, 32 for deeper),
+// their means (`scale` takes the samples to 8-bit code values), converted; `dithered`: with the
+// 4×4 ordered dither.
+template <typename Planes>
+void block_means(const Planes& planes, int width, int height, int block_x, int block_y, const YuvToRgb& matrix,
+                 float scale, bool dithered, std::uint8_t* out, std::size_t out_stride) {
+  using RowSum = std::conditional_t<sizeof(*planes.y) == 1, std::int16_t, std::int32_t>;
   const int out_w = width / block_x, out_h = height / block_y;
   const int chroma_w = width / 2, chroma_bx = block_x / 2, chroma_by = block_y / 2;
-  std::vector<std::int16_t> y_rows(static_cast<std::size_t>(width)), u_rows(static_cast<std::size_t>(chroma_w)),
+  std::vector<RowSum> y_rows(static_cast<std::size_t>(width)), u_rows(static_cast<std::size_t>(chroma_w)),
       v_rows(static_cast<std::size_t>(chroma_w));
   std::vector<std::int32_t> y_sum(static_cast<std::size_t>(out_w)), u_sum(static_cast<std::size_t>(out_w)),
       v_sum(static_cast<std::size_t>(out_w));
-  const float y_scale = 1.f / static_cast<float>(block_x * block_y);
-  const float c_scale = 1.f / static_cast<float>(chroma_bx * chroma_by);
+  const float y_scale = scale / static_cast<float>(block_x * block_y);
+  const float c_scale = scale / static_cast<float>(chroma_bx * chroma_by);
+  // The 4×4 Bayer matrix, as offsets in −0.5..0.5 of a code, one row of them per output row mod 4.
+  static constexpr int kBayer[4][4] = {{0, 8, 2, 10}, {12, 4, 14, 6}, {3, 11, 1, 9}, {15, 7, 13, 5}};
+  std::vector<float> dither[4];
+  if (dithered)
+    for (int r = 0; r < 4; ++r) {
+      dither[r].resize(static_cast<std::size_t>(out_w));
+      for (int o = 0; o < out_w; ++o) dither[r][static_cast<std::size_t>(o)] = (kBayer[r][o % 4] + 0.5f) / 16.f - 0.5f;
+    }
   for (int oy = 0; oy < out_h; ++oy) {
     sum_rows(planes.y + static_cast<std::ptrdiff_t>(oy) * block_y * planes.y_stride, planes.y_stride, block_y, width,
              y_rows.data());
@@ -180,42 +196,22 @@ void yuv420_block_means(const Yuv420Planes& planes, int width, int height, int b
     sum_columns(u_rows.data(), out_w, chroma_bx, u_sum.data());
     sum_columns(v_rows.data(), out_w, chroma_bx, v_sum.data());
     convert_row(y_sum.data(), u_sum.data(), v_sum.data(), out_w, y_scale, c_scale, matrix,
-                out + static_cast<std::size_t>(oy) * out_stride);
+                out + static_cast<std::size_t>(oy) * out_stride, dithered ? dither[oy % 4].data() : nullptr);
   }
+}
+
+}  // namespace
+
+void yuv420_block_means(const Yuv420Planes& planes, int width, int height, int block_x, int block_y,
+                        const YuvToRgb& matrix, std::uint8_t* out, std::size_t out_stride) {
+  block_means(planes, width, height, block_x, block_y, matrix, 1.f, false, out, out_stride);
 }
 
 void yuv420_block_means(const Yuv420Planes16& planes, int width, int height, int block_x, int block_y,
                         const YuvToRgb& matrix, std::uint8_t* out, std::size_t out_stride) {
-  const int out_w = width / block_x, out_h = height / block_y;
-  const int chroma_w = width / 2, chroma_bx = block_x / 2, chroma_by = block_y / 2;
-  std::vector<std::int32_t> y_rows(static_cast<std::size_t>(width)), u_rows(static_cast<std::size_t>(chroma_w)),
-      v_rows(static_cast<std::size_t>(chroma_w));
-  std::vector<std::int32_t> y_sum(static_cast<std::size_t>(out_w)), u_sum(static_cast<std::size_t>(out_w)),
-      v_sum(static_cast<std::size_t>(out_w));
-  // Means in 8-bit code values, at full precision.
-  const float to_8_bits = 1.f / static_cast<float>(1 << (planes.bits - 8));
-  const float y_scale = to_8_bits / static_cast<float>(block_x * block_y);
-  const float c_scale = to_8_bits / static_cast<float>(chroma_bx * chroma_by);
-  // The 4×4 Bayer matrix, as offsets in −0.5..0.5 of a code, one row of them per output row mod 4.
-  static constexpr int kBayer[4][4] = {{0, 8, 2, 10}, {12, 4, 14, 6}, {3, 11, 1, 9}, {15, 7, 13, 5}};
-  std::vector<float> dither[4];
-  for (int r = 0; r < 4; ++r) {
-    dither[r].resize(static_cast<std::size_t>(out_w));
-    for (int o = 0; o < out_w; ++o) dither[r][static_cast<std::size_t>(o)] = (kBayer[r][o % 4] + 0.5f) / 16.f - 0.5f;
-  }
-  for (int oy = 0; oy < out_h; ++oy) {
-    sum_rows(planes.y + static_cast<std::ptrdiff_t>(oy) * block_y * planes.y_stride, planes.y_stride, block_y, width,
-             y_rows.data());
-    sum_rows(planes.u + static_cast<std::ptrdiff_t>(oy) * chroma_by * planes.u_stride, planes.u_stride, chroma_by,
-             chroma_w, u_rows.data());
-    sum_rows(planes.v + static_cast<std::ptrdiff_t>(oy) * chroma_by * planes.v_stride, planes.v_stride, chroma_by,
-             chroma_w, v_rows.data());
-    sum_columns(y_rows.data(), out_w, block_x, y_sum.data());
-    sum_columns(u_rows.data(), out_w, chroma_bx, u_sum.data());
-    sum_columns(v_rows.data(), out_w, chroma_bx, v_sum.data());
-    convert_row(y_sum.data(), u_sum.data(), v_sum.data(), out_w, y_scale, c_scale, matrix,
-                out + static_cast<std::size_t>(oy) * out_stride, dither[oy % 4].data());
-  }
+  // Means in 8-bit code values, at full precision, dithered.
+  block_means(planes, width, height, block_x, block_y, matrix, 1.f / static_cast<float>(1 << (planes.bits - 8)), true,
+              out, out_stride);
 }
 
 }  // namespace nelf
