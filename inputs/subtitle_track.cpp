@@ -102,6 +102,17 @@ void sample(const BitmapRect& rect, double cx, double cy, int rgba[4]) {
   for (int c = 0; c < 4; ++c) rgba[c] = static_cast<int>(std::lround(sum[c]));
 }
 
+// Opens `path` as FFmpeg reads a subtitle file or a movie for its subtitles: files and pipes only
+// (a local playlist naming http:// entries is not fetched; the movie's own source asks for
+// --allow-network, subtitles are only looked for in local files).
+int open_local(AVFormatContext** format, const std::string& path) {
+  AVDictionary* options = nullptr;
+  av_dict_set(&options, "protocol_whitelist", "file,pipe", 0);
+  const int opened = avformat_open_input(format, path.c_str(), nullptr, &options);
+  av_dict_free(&options);
+  return opened;
+}
+
 std::string stream_language(const AVFormatContext& format, unsigned i) {
   const AVDictionaryEntry* tag = av_dict_get(format.streams[i]->metadata, "language", nullptr, 0);
   return tag ? tag->value : "";
@@ -146,8 +157,7 @@ struct SubtitleTrack::Impl {
 
   void open() {
     AVFormatContext* raw = nullptr;
-    if (const int err = avformat_open_input(&raw, path.c_str(), nullptr, nullptr); err < 0)
-      fail(fmt::format("cannot open subtitles: {}", av_error(err)));
+    if (const int err = open_local(&raw, path); err < 0) fail(fmt::format("cannot open subtitles: {}", av_error(err)));
     format.reset(raw);
     if (const int err = avformat_find_stream_info(format.get(), nullptr); err < 0)
       fail(fmt::format("cannot read subtitles: {}", av_error(err)));
@@ -376,7 +386,7 @@ struct SubtitleTrack::Impl {
     if (from_start || avformat_seek_file(format.get(), -1, std::numeric_limits<std::int64_t>::min(), ts, ts, 0) < 0) {
       const int index = stream->index;
       AVFormatContext* raw = nullptr;
-      if (avformat_open_input(&raw, path.c_str(), nullptr, nullptr) < 0) return;
+      if (open_local(&raw, path) < 0) return;
       ffmpeg::FormatContextPtr again(raw);
       if (avformat_find_stream_info(again.get(), nullptr) < 0 || index >= static_cast<int>(again->nb_streams)) return;
       for (unsigned i = 0; i < again->nb_streams; ++i)
@@ -465,7 +475,7 @@ std::vector<std::string> SubtitleTrack::beside(const std::string& movie) {
 
 std::vector<std::string> SubtitleTrack::streams(const std::string& path) {
   AVFormatContext* raw = nullptr;
-  if (avformat_open_input(&raw, path.c_str(), nullptr, nullptr) < 0) return {};
+  if (open_local(&raw, path) < 0) return {};
   const ffmpeg::FormatContextPtr format(raw);
   if (avformat_find_stream_info(format.get(), nullptr) < 0) return {};
   std::vector<std::string> found;
