@@ -187,6 +187,7 @@ void run_convert_video(const ConvertArgs& args, const InputFiles& inputs) {
   r.strict = args.strict;
   r.allow_network = args.allow_network;
   r.max_pixels = args.max_pixels;
+  r.device_options = parse_device_options(args, {args.input});
   if (is_raw_output(args.output)) {
     refuse_options_raw_cannot_apply(args);
     if (!args.quiet) quiet_ffmpeg_logs(true);
@@ -357,6 +358,28 @@ void add_common_options(CLI::App& cmd, CommonArgs& args, bool with_input) {
   add_depth_option(cmd, args.depth);
   add_defect_compensation_option(cmd, args.no_defect_compensation);
   add_max_pixels_option(cmd, args.max_pixels);
+  cmd.add_option("--device-option", args.device_options,
+                 "For a capture device (v4l2:, device:): one of its options as KEY=VALUE, as ffmpeg takes it before "
+                 "-i (video_size=1920x1080, input_format=mjpeg, framerate=60); repeatable");
+}
+
+std::vector<std::pair<std::string, std::string>> parse_device_options(const CommonArgs& args,
+                                                                      const std::vector<std::string>& inputs) {
+  std::vector<std::pair<std::string, std::string>> options;
+  if (args.device_options.empty()) return options;
+  for (const std::string& input : inputs)
+    if (input.rfind("v4l2:", 0) != 0 && input.rfind("device:", 0) != 0)
+      throw UserError(fmt::format("--device-option is for capture devices (v4l2:/dev/videoN, device:FORMAT:INPUT), "
+                                  "not {}",
+                                  printable(input)),
+                      2);
+  for (const std::string& option : args.device_options) {
+    const std::size_t equals = option.find('=');
+    if (equals == 0 || equals == std::string::npos)
+      throw UserError(fmt::format("--device-option {}: KEY=VALUE, e.g. video_size=1920x1080", printable(option)), 2);
+    options.emplace_back(option.substr(0, equals), option.substr(equals + 1));
+  }
+  return options;
 }
 
 void add_depth_option(CLI::App& cmd, std::string& depth) {

@@ -4,11 +4,11 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "app/commands.hpp"
-#include "player/input_files.hpp"
-#include "optics/design.hpp"
 #include "analysis/design_plot.hpp"
+#include "app/commands.hpp"
+#include "optics/design.hpp"
 #include "optics/profile.hpp"
+#include "player/input_files.hpp"
 
 namespace nelf::app {
 

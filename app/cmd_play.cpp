@@ -213,6 +213,7 @@ PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::
   request.stop = &interrupt_requested;
   request.quiet = args.quiet;
   request.allow_network = args.allow_network;
+  request.device_options = parse_device_options(args, entries);
   request.max_pixels = args.max_pixels;
   const WatchLater watch_later(args.remember ? WatchLater::default_state_home() : std::filesystem::path());
 

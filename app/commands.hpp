@@ -50,6 +50,7 @@ struct CommonArgs {
   bool allow_network = false;
   std::int64_t max_pixels = kDefaultMaxPixels;
   bool no_defect_compensation = false;
+  std::vector<std::string> device_options;  // --device-option KEY=VALUE, for v4l2: and device: inputs
 };
 
 // CommonArgs checked before any input is read: layout, antialiasing, device, profile and signal.
@@ -75,6 +76,11 @@ void add_max_pixels_option(CLI::App& cmd, std::int64_t& max_pixels);
 // Throws UserError (status 2) for contradictory options and unknown signals, ProfileError for bad
 // profiles. `still`: the input is a still image (refuses layout alt).
 CommonOptions parse_common_options(const CommonArgs& args, bool still);
+
+// --device-option KEY=VALUE, each split; when one of `inputs` is no capture device (v4l2:,
+// device:), or without '=', a UserError (status 2).
+std::vector<std::pair<std::string, std::string>> parse_device_options(const CommonArgs& args,
+                                                                      const std::vector<std::string>& inputs);
 
 // --gpu picks the EGL device of headless rendering; a live output renders on its display's own GPU
 // (a GLX context, or the DRM card of kms), so there the option is refused rather than ignored.

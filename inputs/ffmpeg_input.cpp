@@ -66,7 +66,9 @@ bool is_regular_file(const std::string& path) {
 
 bool is_url(const std::string& path) { return path.find("://") != std::string::npos || path.rfind("pipe:", 0) == 0; }
 
-int open_input(FormatContextPtr& format, const std::string& path, InputGuard& guard, const AVInputFormat* device) {
+int open_input(FormatContextPtr& format, const std::string& path, InputGuard& guard, const AVInputFormat* device,
+               const std::vector<std::pair<std::string, std::string>>& device_options,
+               std::vector<std::string>* unknown) {
   const std::string url = device != nullptr || is_url(path) ? path : "file:" + path;
   AVFormatContext* raw = avformat_alloc_context();
   if (raw == nullptr) return AVERROR(ENOMEM);
@@ -88,8 +90,12 @@ int open_input(FormatContextPtr& format, const std::string& path, InputGuard& gu
     // writes to it while nelf reads (found by fuzzing): give up after two reloads that bring nothing.
     av_dict_set(&raw_options, "m3u8_hold_counters", "2", 0);
   }
+  for (const auto& [key, value] : device_options) av_dict_set(&raw_options, key.c_str(), value.c_str(), 0);
   const int opened = avformat_open_input(&raw, url.c_str(), device, &raw_options);  // frees raw on failure
   DictionaryPtr unused(raw_options);
+  if (unknown)
+    for (const auto& [key, value] : device_options)
+      if (av_dict_get(unused.get(), key.c_str(), nullptr, 0)) unknown->push_back(key);
   if (opened >= 0) format.reset(raw);
   return opened;
 }

@@ -7,6 +7,8 @@
 #include <chrono>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/ffmpeg_raii.hpp"
 
@@ -38,9 +40,13 @@ struct InputGuard {
 // URL the demuxer opens on a protocol other than file or pipe is refused and recorded in `guard`,
 // and opening a regular file is interrupted after guard.opening_limit (until find_stream_info).
 // With `device` (a libavdevice input format: v4l2, x11grab, lavfi, …), `path` is the device's own
-// name for its input (/dev/video0, :0.0, a filter graph), opened as it is.
+// name for its input (/dev/video0, :0.0, a filter graph), opened as it is, with `device_options`
+// (KEY, VALUE: the device's own, as ffmpeg -video_size sets them); the keys the device does not take
+// are put in `unknown`.
 int open_input(FormatContextPtr& format, const std::string& path, InputGuard& guard,
-               const AVInputFormat* device = nullptr);
+               const AVInputFormat* device = nullptr,
+               const std::vector<std::pair<std::string, std::string>>& device_options = {},
+               std::vector<std::string>* unknown = nullptr);
 
 // avformat_find_stream_info under the same guard, `options` as FFmpeg takes them (one dictionary per
 // stream, or null); ends the opening deadline, so that reading later is never interrupted by it.

@@ -233,7 +233,8 @@ class FileFrameSource final : public Source {
   static VideoSource open_device(const std::string& spec, const std::string& device_input, const SourceRequest& r,
                                  const std::string& device) {
     try {
-      return VideoSource(device_input, VideoSourceOptions{r.allow_network, true, r.max_pixels, device});
+      return VideoSource(device_input,
+                         VideoSourceOptions{r.allow_network, true, r.max_pixels, device, r.device_options});
     } catch (const VideoError& e) {
       std::string what = e.what();
       if (what.rfind(device_input + ": ", 0) == 0) what.erase(0, device_input.size() + 2);

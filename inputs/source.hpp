@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/audio_stream.hpp"
@@ -40,6 +41,9 @@ struct SourceRequest {
   // Set from elsewhere (Ctrl-C): a live source waiting, while it opens, for what it reads (a window
   // that is not there yet) gives up, with status 130.
   const std::atomic<bool>* stop = nullptr;
+  // --device-option KEY=VALUE for a capture device (v4l2:, device:): its own options, as ffmpeg
+  // takes -video_size or -input_format before -i.
+  std::vector<std::pair<std::string, std::string>> device_options{};
 };
 
 // What a source says about its stream once it is open.

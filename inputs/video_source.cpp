@@ -140,8 +140,13 @@ struct VideoSource::Impl {
 
     // Playlists (HLS, concat, …) can otherwise make FFmpeg fetch URLs (DESIGN.md §11).
     network.allow_network = options.allow_network;
-    const int opened = open_input(format, path, network, device);
+    std::vector<std::string> unknown;
+    const int opened = open_input(format, path, network, device, options.device_options, &unknown);
     if (const auto stopped = guard_stop(path, network)) throw VideoError(*stopped);
+    if (!unknown.empty())
+      throw VideoError(
+          fmt::format("{}: the {} device has no option {} (--device-option; ffmpeg -h demuxer={} lists them)", path,
+                      options.device, unknown.front(), options.device));
     if (opened < 0) {
       if (opened == AVERROR_INVALIDDATA) fail("not a media file FFmpeg can read");
       if (opened == AVERROR(EACCES)) fail("permission denied");

@@ -13,6 +13,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/image.hpp"
@@ -105,6 +106,8 @@ struct VideoSourceOptions {
   // A libavdevice input format (v4l2, x11grab, lavfi, …): the path is then that device's name for
   // its input (/dev/video0, :0.0, a filter graph), read live. Empty: a file or URL.
   std::string device;
+  // --device-option KEY=VALUE: the device's own options (video_size, input_format, framerate, …).
+  std::vector<std::pair<std::string, std::string>> device_options{};
 };
 
 // What went wrong while decoding, so that the caller can warn (or refuse, with --strict).

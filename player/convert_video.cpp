@@ -113,6 +113,7 @@ std::unique_ptr<FrameSink> open_frame_sink(const VideoConvertRequest& r, Source&
 void convert_video(const VideoConvertRequest& r) {
   InterruptGuard guard;
   SourceRequest request{r.input, r.right, r.layout, r.swap_eyes, r.start_s, r.quiet, r.allow_network, r.max_pixels};
+  request.device_options = r.device_options;
   request.stop = &interrupt_requested;
   // Subtitles before the input (which says a line about itself), so that subtitles that cannot
   // be burned in are the only line said; an input that is not there is said as such first.

@@ -40,6 +40,7 @@ struct VideoConvertRequest {
   bool quiet = false;
   bool strict = false;
   bool allow_network = false;
+  std::vector<std::pair<std::string, std::string>> device_options;  // --device-option
   std::int64_t max_pixels = kDefaultMaxPixels;
   std::optional<SubtitleBurn> burn_subs;
 };

@@ -115,6 +115,25 @@ TEST_F(LiveCliTest, FfmpegCaptureDevicesAreInputsToo) {
                                 shell_quote(screen.string()) + " --layout mono --frames 5");
   ASSERT_EQ(grabbed.status, 0) << grabbed.err;
   EXPECT_EQ(frames(screen), "1280,1470,5\n");
+  // The device's own options, as ffmpeg takes -video_size before -i: x11grab grabs 320x240 of the screen.
+  const auto corner =
+      run_nelf("convert " + shell_quote("device:x11grab:" + xvfb_.display_name()) + " " +
+               shell_quote((dir_.path() / "corner.mkv").string()) +
+               " --layout mono --frames 2 --device-option video_size=320x240 --device-option framerate=10");
+  ASSERT_EQ(corner.status, 0) << corner.err;
+  EXPECT_NE(corner.err.find(": 320x240 rawvideo, layout mono"), std::string::npos) << corner.err;
+}
+
+TEST_F(LiveCliTest, DeviceOptionsAreTheDevicesOwnOrOneLine) {
+  const std::string device = shell_quote("device:lavfi:testsrc2=size=640x180:rate=30");
+  test::expect_clean_failure(dir_, "convert " + device + " out.mkv --duration 1 --device-option nosuch=1", 1,
+                             "the lavfi device has no option nosuch (--device-option; ffmpeg -h demuxer=lavfi");
+  test::expect_clean_failure(dir_, "convert " + device + " out.mkv --duration 1 --device-option video_size", 2,
+                             "--device-option video_size: KEY=VALUE");
+  test::expect_clean_failure(dir_, "convert synthetic: out.mkv --frames 1 --device-option video_size=1x1", 2,
+                             "--device-option is for capture devices");
+  test::expect_clean_failure(dir_, "play synthetic: --output offscreen --device-option video_size=1x1", 2,
+                             "--device-option is for capture devices");
 }
 
 TEST_F(LiveCliTest, ProbeSaysItDescribesFiles) {
