@@ -61,29 +61,17 @@ void PlayCommands::update_preview_caption() {
   if (!caption_label_) caption_label_ = std::make_unique<TextOverlay>();
   caption_label_->set_text(now.message);
   caption_label_->set_bar(now.bar);
-  // The label as a 1280×720 view gets it (cap height 36 px), cut to its box, over black.
-  constexpr int kWidth = 1280, kHeight = 720;
-  const Image cover = caption_label_->cover(kWidth, kHeight, 0.0);
-  int x0 = kWidth, y0 = kHeight, x1 = -1, y1 = -1;
-  for (int y = 0; y < kHeight; ++y)
-    for (int x = 0; x < kWidth; ++x)
-      if (cover.data()[(static_cast<std::size_t>(y) * kWidth + x) * 4 + 3] > 0.f) {
-        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
-      }
-  if (x1 < 0) {
-    display_.set_preview_caption({});
-    return;
-  }
-  PreviewCaption caption{x1 - x0 + 1, y1 - y0 + 1, {}};
+  // At the size a 720-row view's message has (1/16 of it), over black: the window scales it.
+  constexpr int kFontPx = 45;
+  const Image label = caption_label_->label_image(kFontPx);
+  PreviewCaption caption{label.width(), label.height(), {}};
   caption.rgba.resize(static_cast<std::size_t>(caption.width) * caption.height * 4);
-  for (int y = 0; y < caption.height; ++y)
-    for (int x = 0; x < caption.width; ++x) {
-      const float* p = &cover.data()[(static_cast<std::size_t>(y0 + y) * kWidth + x0 + x) * 4];
-      std::uint8_t* q = &caption.rgba[(static_cast<std::size_t>(y) * caption.width + x) * 4];
-      for (int c = 0; c < 3; ++c)
-        q[c] = static_cast<std::uint8_t>(std::lround(std::clamp(p[c] * p[3], 0.f, 1.f) * 255.f));
-      q[3] = 255;
-    }
+  for (std::size_t i = 0; i < caption.rgba.size(); i += 4) {
+    const float* p = &label.data()[i];
+    for (int c = 0; c < 3; ++c)
+      caption.rgba[i + c] = static_cast<std::uint8_t>(std::lround(std::clamp(p[c] * p[3], 0.f, 1.f) * 255.f));
+    caption.rgba[i + 3] = 255;
+  }
   display_.set_preview_caption(std::move(caption));
 }
 

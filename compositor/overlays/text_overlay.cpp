@@ -174,6 +174,14 @@ Image TextOverlay::cover(int width, int height, double aspect) {
   return out;
 }
 
+Image TextOverlay::label_image(int font_px) {
+  if (text_.empty()) return Image();
+  const Label& text = cpu_label(font_px);
+  Image out(text.width, text.height);
+  for (std::size_t i = 0; i < text.rgba.size(); ++i) out.data()[i] = text.rgba[i] / 255.f;
+  return out;
+}
+
 GlTextureView TextOverlay::apply(Eye eye, const GlTextureView& view) {
   EyeTarget& target = eyes_[static_cast<int>(eye)];
   target.box = {};

@@ -58,6 +58,11 @@ class TextOverlay {
   // Needs no GL. Throws std::runtime_error when the text cannot be rendered (no font).
   Image cover(int width, int height, double aspect);
 
+  // The label itself at `font_px`, at its own size: the text on its translucent dark box (alpha the
+  // box's opacity), as apply() scales it into a view; empty for no text. For a caption shown flat
+  // (the preview window's). Needs no GL. Throws std::runtime_error when the text cannot be rendered.
+  Image label_image(int font_px);
+
  private:
   struct Label {
     std::string text;
