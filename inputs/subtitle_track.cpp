@@ -113,6 +113,12 @@ int open_local(AVFormatContext** format, const std::string& path) {
   return opened;
 }
 
+// The demuxer skips the packets of every stream but `index`.
+void read_only_stream(AVFormatContext& format, int index) {
+  for (unsigned i = 0; i < format.nb_streams; ++i)
+    if (static_cast<int>(i) != index) format.streams[i]->discard = AVDISCARD_ALL;
+}
+
 std::string stream_language(const AVFormatContext& format, unsigned i) {
   const AVDictionaryEntry* tag = av_dict_get(format.streams[i]->metadata, "language", nullptr, 0);
   return tag ? tag->value : "";
@@ -171,8 +177,7 @@ struct SubtitleTrack::Impl {
       video_w = format->streams[video]->codecpar->width;
       video_h = format->streams[video]->codecpar->height;
     }
-    for (unsigned i = 0; i < format->nb_streams; ++i)
-      if (static_cast<int>(i) != index) format->streams[i]->discard = AVDISCARD_ALL;
+    read_only_stream(*format, index);
     const AVCodec* decoder = avcodec_find_decoder(stream->codecpar->codec_id);
     if (!decoder) fail(fmt::format("no decoder for subtitles in {}", avcodec_get_name(stream->codecpar->codec_id)));
     codec.reset(avcodec_alloc_context3(decoder));
@@ -389,8 +394,7 @@ struct SubtitleTrack::Impl {
       if (open_local(&raw, path) < 0) return;
       ffmpeg::FormatContextPtr again(raw);
       if (avformat_find_stream_info(again.get(), nullptr) < 0 || index >= static_cast<int>(again->nb_streams)) return;
-      for (unsigned i = 0; i < again->nb_streams; ++i)
-        if (static_cast<int>(i) != index) again->streams[i]->discard = AVDISCARD_ALL;
+      read_only_stream(*again, index);
       format = std::move(again);
       stream = format->streams[index];
     }
