@@ -72,11 +72,11 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
   std::shared_ptr<SubtitleTrack> subtitles;
   std::error_code not_a_file;
   const SubtitleStreamChoice stream{parse_track_number(args.sid, "--sid"), args.slang};
+  const SubtitleStereo sub_stereo = parse_sub_stereo(args.sub_stereo);
   const bool has_own_subtitles =
       args.subtitles && (!args.sub_file.empty() || std::filesystem::is_regular_file(request.input, not_a_file));
   if (has_own_subtitles && !args.no_subs && args.sid != "no")
-    subtitles = choose_subtitles(request.input, args.sub_file, 0.0, false, args.quiet, stream,
-                                 parse_sub_stereo(args.sub_stereo));
+    subtitles = choose_subtitles(request.input, args.sub_file, 0.0, false, args.quiet, stream, sub_stereo);
   const auto source = open_source_for_depth(request, common.compositor.depth, common.profile);
   const SourceInfo info = source->info();
 
@@ -130,7 +130,7 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
   if (!info.still && has_own_subtitles) tracks = subtitle_tracks(request.input, args.sub_file);
   if (!info.still && (subtitles || !tracks.empty())) {
     options.subtitle_tracks = std::move(tracks);
-    options.sub_stereo = parse_sub_stereo(args.sub_stereo);
+    options.sub_stereo = sub_stereo;
     options.sub_parallax_percent = parse_sub_parallax(args.sub_parallax);
     if (!args.sub_parallax && record.sub_parallax && std::abs(*record.sub_parallax) <= max_sub_parallax_percent) {
       options.sub_parallax_percent = *record.sub_parallax;
