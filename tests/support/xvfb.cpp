@@ -111,6 +111,8 @@ XvfbServer::~XvfbServer() {
   }
 }
 
+bool XvfbServer::running() const { return pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) == 0; }
+
 void XvfbServer::kill_now() {
   if (pid_ <= 0) return;
   kill(pid_, SIGKILL);

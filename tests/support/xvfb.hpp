@@ -20,6 +20,9 @@ class XvfbServer {
   // Kills the server at once (SIGKILL), as when an X session ends under a running program.
   void kill_now();
 
+  // Whether the server process is still alive (a test that lost its windows says which side went).
+  bool running() const;
+
   // ":N", for setenv("DISPLAY", …) or a child's environment.
   const std::string& display_name() const { return display_name_; }
 

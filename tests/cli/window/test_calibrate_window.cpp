@@ -85,9 +85,15 @@ class CalibrateWindowTest : public ::testing::Test {
                                            process.pid(), shell_quote("^nelf calibrate")));
     return r.out.substr(0, r.out.find('\n'));
   }
-  void keys(const std::string& window, const std::string& keys) {
+  // Types `keys` into `window`. When that fails, says why the window is gone: nelf ended (its
+  // status and stderr), or the test's X server did.
+  void keys(NelfProcess& nelf, const std::string& window, const std::string& keys) {
     const auto r = run_command("xdotool key --delay 5 --window " + window + " " + keys);
-    ASSERT_EQ(r.status, 0) << r.err;
+    if (r.status == 0) return;
+    const std::optional<int> status = nelf.wait(std::chrono::milliseconds(0));
+    FAIL() << r.err << "nelf " << (status ? "ended with status " + std::to_string(*status) : std::string("still runs"))
+           << "; the test's Xvfb " << (xvfb_.running() ? "still runs" : "has ended")
+           << "; nelf said: " << test::read_file(dir_ / "err.txt");
   }
 
   test::XvfbServer xvfb_;
@@ -102,7 +108,7 @@ TEST_F(CalibrateWindowTest, KeysChangeWhatSaveWrites) {
   ASSERT_FALSE(window.empty()) << test::read_file(dir_ / "err.txt");
   // Both eyes 2 px right; the left eye rotated +0.1 deg and 0.1 px up; the right eye 1 px left;
   // then both eyes: IPD +0.5 mm, prescription -0.25 D, gap +0.005 mm, pitch scale +0.0005; quit.
-  keys(window, "Right Right Tab R R shift+Up Tab Left Tab bracketright d G P 3 2 q");
+  keys(nelf, window, "Right Right Tab R R shift+Up Tab Left Tab bracketright d G P 3 2 q");
   const auto status = nelf.wait(std::chrono::seconds(30));
   ASSERT_TRUE(status) << "nelf calibrate did not quit on q";
   const std::string out = test::read_file(dir_ / "out.txt");
@@ -148,7 +154,7 @@ TEST_F(CalibrateWindowTest, WritesOnWAndStartsFromTheGivenProfile) {
       dir_ / "out.txt", dir_ / "err.txt");
   const std::string window = find_window(nelf);
   ASSERT_FALSE(window.empty()) << test::read_file(dir_ / "err.txt");
-  keys(window, "bracketleft w");
+  keys(nelf, window, "bracketleft w");
   // w saves while the window stays open.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   while (load_profile(saved.string()).viewing.ipd_mm != 59.5 && std::chrono::steady_clock::now() < deadline)
@@ -227,7 +233,7 @@ TEST_F(CalibrateWindowTest, TheWindowShowsWhatTheHeadlessPatternWrites) {
     difference /= pixels;
     if (difference >= 2.0 / 255 || gap > 0) std::this_thread::sleep_for(std::chrono::milliseconds(300));
   }
-  keys(window, "q");
+  keys(nelf, window, "q");
   ASSERT_TRUE(nelf.wait(std::chrono::seconds(20)));
   const std::string why = fmt::format("after {} captures of {}x{} at {},{}; nelf said: {}", captures, width, height, x,
                                       y, test::read_file(dir_ / "err.txt"));
@@ -241,7 +247,7 @@ TEST_F(CalibrateWindowTest, ClosingTheWindowSavesAndExitsCleanly) {
   NelfProcess nelf("calibrate --save " + shell_quote(saved.string()), dir_ / "out.txt", dir_ / "err.txt");
   const std::string window = find_window(nelf);
   ASSERT_FALSE(window.empty()) << test::read_file(dir_ / "err.txt");
-  keys(window, "D D");
+  keys(nelf, window, "D D");
   // The keys are queued before the close request, so they are handled first.
   test::request_window_close(xvfb_.display_name(), window);
   const auto status = nelf.wait(std::chrono::seconds(20));
@@ -260,7 +266,7 @@ TEST_F(CalibrateWindowTest, DefectsKeysMarkPixelsAndSaveTheMapBesideTheProfile) 
   // Left (640, 360) dead; 11 px right on the white field stuck white; the right eye 100 px up and
   // 1 left on the green field (space: white -> red -> green) stuck green; one more right, dead,
   // then unmarked with Backspace; a pixel on the left eye marked and unmarked with u; w; q.
-  keys(window, "d Right shift+Right 2 s Tab ctrl+Up Left space space s Right d BackSpace Tab Down d u w q");
+  keys(nelf, window, "d Right shift+Right 2 s Tab ctrl+Up Left space space s Right d BackSpace Tab Down d u w q");
   const auto status = nelf.wait(std::chrono::seconds(30));
   ASSERT_TRUE(status) << "nelf calibrate --defects did not quit on q";
   const std::string out = test::read_file(dir_ / "out.txt");
