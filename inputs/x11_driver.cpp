@@ -16,46 +16,19 @@
 #include "core/user_error.hpp"
 #include "inputs/source.hpp"
 #include "inputs/stereo_layout.hpp"
+#include "inputs/view_bytes.hpp"
 #include "inputs/view_regions.hpp"
 #include "inputs/x11_capture.hpp"
 
 namespace nelf::drivers {
 namespace {
 
-// `rect` of the image as (width / bx) × (height / by) means of bx × by pixels (1 × 1: a copy), the
-// ViewFormat the compositor negotiated: the compositor's first prefilter pass done while the
-// window's pixels are in cache, and what lets it composite from its CPU tables.
+// `rect` of the image as the block means the compositor negotiated.
 std::vector<std::uint8_t> view_of(const CapturedImage& image, const PixelRect& rect, std::array<int, 2> block) {
-  const int bx = block[0], by = block[1];
-  const int w = rect.width / bx, h = rect.height / by;
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(w) * h * 4);
-  if (bx == 1 && by == 1) {
-    for (int y = 0; y < h; ++y)
-      std::memcpy(&out[static_cast<std::size_t>(y) * w * 4],
-                  &image.rgba[(static_cast<std::size_t>(rect.y + y) * image.width + rect.x) * 4],
-                  static_cast<std::size_t>(w) * 4);
-    return out;
-  }
-  const unsigned n = static_cast<unsigned>(bx * by);
-  std::vector<unsigned> sums(static_cast<std::size_t>(w) * 3);
-  for (int y = 0; y < h; ++y) {
-    std::fill(sums.begin(), sums.end(), 0u);
-    for (int j = 0; j < by; ++j) {
-      const std::uint8_t* row = &image.rgba[(static_cast<std::size_t>(rect.y + y * by + j) * image.width + rect.x) * 4];
-      for (int x = 0; x < w; ++x)
-        for (int i = 0; i < bx; ++i, row += 4) {
-          sums[x * 3] += row[0];
-          sums[x * 3 + 1] += row[1];
-          sums[x * 3 + 2] += row[2];
-        }
-    }
-    std::uint8_t* dst = &out[static_cast<std::size_t>(y) * w * 4];
-    for (int x = 0; x < w; ++x, dst += 4) {
-      for (int c = 0; c < 3; ++c) dst[c] = static_cast<std::uint8_t>((sums[x * 3 + c] + n / 2) / n);
-      dst[3] = 255;
-    }
-  }
-  return out;
+  const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(image.width) * 4;
+  return rgba8_block_means(
+      &image.rgba[static_cast<std::size_t>(rect.y) * stride + static_cast<std::size_t>(rect.x) * 4], stride, rect.width,
+      rect.height, block);
 }
 
 class X11FrameSource final : public Source {

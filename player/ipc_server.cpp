@@ -21,52 +21,10 @@ namespace {
 // client is dropped rather than nelf's memory growing for it.
 constexpr std::size_t max_buffered = 1 << 20;
 
-[[noreturn]] void refuse(const std::string& path, const std::string& why) {
-  throw UserError(fmt::format("--input-ipc-server {}: {}", path, why), 2);
-}
-
 }  // namespace
 
-UniqueFd::~UniqueFd() {
-  if (fd_ >= 0) ::close(fd_);
-}
-
-UniqueFd& UniqueFd::operator=(UniqueFd&& other) noexcept {
-  if (this != &other) {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = other.release();
-  }
-  return *this;
-}
-
-IpcServer::IpcServer(std::string path) : path_(std::move(path)) {
-  sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  if (path_.empty() || path_.size() >= sizeof(address.sun_path))
-    refuse(path_, fmt::format("a socket's path must be 1 to {} bytes long", sizeof(address.sun_path) - 1));
-  std::memcpy(address.sun_path, path_.c_str(), path_.size() + 1);
-
-  struct stat there {};
-  if (::lstat(path_.c_str(), &there) == 0) {
-    if (!S_ISSOCK(there.st_mode)) refuse(path_, "exists and is not a socket");
-    if (::unlink(path_.c_str()) != 0) refuse(path_, std::strerror(errno));
-  }
-
-  listener_ = UniqueFd(::socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0));
-  if (listener_.get() < 0) refuse(path_, std::strerror(errno));
-  // Owner-only from the moment it exists: the socket drives the player, so nobody else may
-  // connect even between bind() and a chmod().
-  const mode_t old_mask = ::umask(0177);
-  const int bound = ::bind(listener_.get(), reinterpret_cast<const sockaddr*>(&address), sizeof(address));
-  const int bind_errno = errno;
-  ::umask(old_mask);
-  if (bound != 0) refuse(path_, std::strerror(bind_errno));
-  if (::chmod(path_.c_str(), 0600) != 0 || ::listen(listener_.get(), 8) != 0) {
-    const int e = errno;
-    ::unlink(path_.c_str());
-    refuse(path_, std::strerror(e));
-  }
-}
+IpcServer::IpcServer(std::string path)
+    : path_(std::move(path)), listener_(listen_on_unix_socket(path_, "--input-ipc-server")) {}
 
 IpcServer::~IpcServer() {
   clients_.clear();
