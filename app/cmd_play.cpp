@@ -210,7 +210,7 @@ PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::
   // Before the input opens: Ctrl-C also ends a wait for a window that is not there yet.
   InterruptGuard guard;
   SourceRequest request = base;
-  request.stop = &interrupt_requested;
+  if (!request.stop) request.stop = &interrupt_requested;  // nelf run gives its own, which covers this one
   request.quiet = args.quiet;
   request.allow_network = args.allow_network;
   request.device_options = parse_device_options(args, entries);

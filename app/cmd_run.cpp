@@ -1,17 +1,28 @@
-// `nelf run [play options] -- GAME [ARGS...]`: starts a stereo game and shows it on the HMD. The
-// window the game's process opens (its _NET_WM_PID, or the title --window names) is captured live
-// (the x11: source) and played with play's options, its layout detected as for a file or given by
-// --layout. nelf ends when the game does, with the game's exit status; quitting nelf (q, closing
-// its window, Ctrl-C) ends the game too.
+// `nelf run [play options] -- GAME [ARGS...]`: starts a stereo game and shows it on the HMD. A
+// quad-buffer OpenGL game gets nelf's interposer (LD_PRELOAD) and its two eyes come from there (the
+// glx-stereo: source); a game that draws both eyes into one picture has the window its process
+// opens (its _NET_WM_PID, or the title --window names) captured live (the x11: source), its layout
+// detected as for a file or given by --layout. Either is played with play's options. nelf ends when the game does, with
+// the game's exit status; quitting nelf (q, closing its window, Ctrl-C) ends the game too.
 #include <fmt/format.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "app/commands.hpp"
 #include "app/play_command.hpp"
 #include "core/printable.hpp"
+#include "inputs/glx_stereo_protocol.hpp"
+#include "inputs/glx_stereo_source.hpp"
 #include "player/game_process.hpp"
 #include "player/interrupt.hpp"
 
@@ -24,22 +35,77 @@ struct RunArgs : PlayArgs {
   std::vector<std::string> game;
 };
 
+// Whether the game ended (without reaping it: GameProcess does that on nelf's thread).
+bool game_ended(pid_t pid) {
+  siginfo_t info{};
+  return waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT) != 0 || info.si_pid == pid;
+}
+
+// Where this run listens for the interposer: the user's runtime folder, else the temporary one.
+std::string interposer_socket_path() {
+  const char* runtime = std::getenv("XDG_RUNTIME_DIR");
+  const std::filesystem::path folder =
+      runtime && *runtime && std::filesystem::is_directory(runtime) ? runtime : std::filesystem::temp_directory_path();
+  return (folder / fmt::format("nelf-run-{}.sock", getpid())).string();
+}
+
+// How long a game may take to swap its first OpenGL frame before nelf stops expecting its eyes
+// from the interposer and waits for its window alone.
+constexpr double kFirstSwapWait_s = 5;
+
 void run_game(const RunArgs& args, const std::vector<std::string>& command) {
   if (args.wait_s <= 0) throw UserError("--wait must be more than 0 seconds", 2);
   // From the start: a Ctrl-C while the game starts or between its windows ends both too.
   InterruptGuard guard;
-  GameProcess game(command);
-  SourceRequest request;
-  request.stop = &interrupt_requested;
-  // window= takes the rest of the spec (a title may hold commas), so it comes last.
-  request.input = args.window.empty() ? fmt::format("x11:pid={},wait={:g}", game.pid(), args.wait_s)
-                                      : fmt::format("x11:wait={:g},window={}", args.wait_s, args.window);
+  // Quad-buffer games: nelf's interposer goes into the game and hands over both eyes at each swap
+  // (inputs/glx_stereo_source.hpp); a game that draws one picture is played from its window.
+  const std::string socket = interposer_socket_path();
+  std::string preload = glx_stereo_library_path();
+  if (const char* before = std::getenv("LD_PRELOAD"); before && *before) preload += std::string(":") + before;
+  GameProcess game(command, {"LD_PRELOAD=" + preload, std::string(glx_stereo::kSocketVariable) + "=" + socket});
+  // --window names a window to capture: the user says the game draws into one.
+  bool eyes_from_interposer = args.window.empty();
+  // Stops waiting for the first swap when the user interrupts or the game ends without one.
+  std::atomic<bool> stop_waiting{false};
+  std::jthread watcher([&](std::stop_token stop) {
+    while (!stop.stop_requested() && !stop_waiting) {
+      if (interrupt_requested || game_ended(game.pid())) stop_waiting = true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  });
+  RunArgs eyes_args = args;
+  eyes_args.layout = "auto";  // the eyes come on their own; --layout is for a window
   // Games close their window and open another (a splash or launcher first, a new window for a new
   // video mode): while the game runs, nelf plays each window it opens.
   for (bool first = true;; first = false) {
     PlayEnd end = PlayEnd::end_of_file;
     try {
-      end = play_input(args, request);
+      if (eyes_from_interposer) {
+        SourceRequest request;
+        request.stop = &stop_waiting;
+        request.input = fmt::format("glx-stereo:wait={:g},socket={}", kFirstSwapWait_s, socket);
+        try {
+          end = play_input(eyes_args, request);
+        } catch (const GameDrawsOnePicture&) {
+          eyes_from_interposer = false;
+        } catch (const GameDidNotSwap&) {
+          eyes_from_interposer = false;
+          if (!args.quiet)
+            fmt::print(stderr, "nelf: {} swapped no OpenGL frame in {:g} s: waiting for its window\n",
+                       printable(game.name()), kFirstSwapWait_s);
+        } catch (const UserError& e) {
+          if (e.status() != 130 || interrupt_requested) throw;
+          eyes_from_interposer = false;  // the game ended while nelf waited: its status follows
+        }
+      }
+      if (!eyes_from_interposer) {
+        SourceRequest request;
+        request.stop = &interrupt_requested;
+        // window= takes the rest of the spec (a title may hold commas), so it comes last.
+        request.input = args.window.empty() ? fmt::format("x11:pid={},wait={:g}", game.pid(), args.wait_s)
+                                            : fmt::format("x11:wait={:g},window={}", args.wait_s, args.window);
+        end = play_input(args, request);
+      }
     } catch (const UserError& e) {
       // A game that failed before it opened a window says why itself; its status is nelf's.
       if (const std::optional<int> status = game.exit_status(); status && *status != 0 && e.status() != 130)

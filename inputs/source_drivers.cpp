@@ -10,6 +10,8 @@ bool accepts_synthetic(const SourceRequest& request);
 std::unique_ptr<Source> open_synthetic(const SourceRequest& request);
 bool accepts_x11(const SourceRequest& request);
 std::unique_ptr<Source> open_x11(const SourceRequest& request);
+bool accepts_glx_stereo(const SourceRequest& request);
+std::unique_ptr<Source> open_glx_stereo(const SourceRequest& request);
 bool accepts_device(const SourceRequest& request);
 std::unique_ptr<Source> open_device(const SourceRequest& request);
 bool accepts_still(const SourceRequest& request);
@@ -25,6 +27,10 @@ constexpr SourceDriver kDrivers[] = {
      drivers::accepts_synthetic, drivers::open_synthetic},
     {"x11", "x11:[display=:N,fps=N,wait=S,][window=TITLE|window-id=0x…]: a live X11 window (or the screen)",
      drivers::accepts_x11, drivers::open_x11},
+    {"glx-stereo",
+     "glx-stereo:[wait=S,]socket=PATH: a quad-buffer OpenGL game's two eyes, from nelf's interposer in the game "
+     "(nelf run starts it so)",
+     drivers::accepts_glx_stereo, drivers::open_glx_stereo},
     {"device", "v4l2:/dev/videoN, device:FORMAT:INPUT: an FFmpeg capture device (a capture card, x11grab, lavfi, ...)",
      drivers::accepts_device, drivers::open_device},
     {"still", "a stereo photo OpenImageIO reads (.jps, .mpo, .png, .jpg, .tif, .exr, ...; two with --right)",

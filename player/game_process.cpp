@@ -5,9 +5,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <cstring>
+#include <string_view>
 #include <thread>
 
 #include "core/printable.hpp"
@@ -17,7 +19,7 @@ extern char** environ;
 
 namespace nelf {
 
-GameProcess::GameProcess(const std::vector<std::string>& command) {
+GameProcess::GameProcess(const std::vector<std::string>& command, const std::vector<std::string>& environment) {
   if (command.empty()) throw UserError("nelf run needs the game to start: nelf run [options] -- GAME [ARGS...]", 2);
   name_ = command.front();
   std::vector<char*> argv;
@@ -34,7 +36,17 @@ GameProcess::GameProcess(const std::vector<std::string>& command) {
   sigaddset(&defaults, SIGPIPE);
   posix_spawnattr_setsigdefault(&attributes, &defaults);
   posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF);
-  const int failed = posix_spawnp(&pid_, argv[0], nullptr, &attributes, argv.data(), environ);
+  std::vector<char*> env;
+  for (char** e = environ; *e; ++e) {
+    const std::string_view entry(*e);
+    const auto named = [&](const std::string& set) {
+      return entry.substr(0, entry.find('=') + 1) == set.substr(0, set.find('=') + 1);
+    };
+    if (std::none_of(environment.begin(), environment.end(), named)) env.push_back(*e);
+  }
+  for (const std::string& entry : environment) env.push_back(const_cast<char*>(entry.c_str()));
+  env.push_back(nullptr);
+  const int failed = posix_spawnp(&pid_, argv[0], nullptr, &attributes, argv.data(), env.data());
   posix_spawnattr_destroy(&attributes);
   if (failed != 0) {
     pid_ = -1;

@@ -15,8 +15,9 @@ namespace nelf {
 class GameProcess {
  public:
   // Throws UserError (status 127, as a shell says for a command it cannot find) when the command
-  // cannot be started, status 2 when it is empty.
-  explicit GameProcess(const std::vector<std::string>& command);
+  // cannot be started, status 2 when it is empty. `environment`: NAME=VALUE entries set for the
+  // game on top of nelf's own (the quad-buffer interposer's LD_PRELOAD).
+  explicit GameProcess(const std::vector<std::string>& command, const std::vector<std::string>& environment = {});
   ~GameProcess();  // ends() the game if it still runs
   GameProcess(const GameProcess&) = delete;
   GameProcess& operator=(const GameProcess&) = delete;

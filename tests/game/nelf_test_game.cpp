@@ -257,11 +257,12 @@ class GlfwGameWindow final : public GameWindow {
     glfwWindowHint(GLFW_CLIENT_API, GLFW_OPENGL_API);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 2);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 1);
-    // The quad-buffer mode (a stereo framebuffer, GLFW_STEREO) goes here.
+    glfwWindowHint(GLFW_STEREO, o.mode == Mode::quad_buffer ? GLFW_TRUE : GLFW_FALSE);
     window_ = glfwCreateWindow(w, h, o.title.c_str(), nullptr, nullptr);
     if (!window_) {
       glfwTerminate();
-      throw std::runtime_error("GLFW cannot open a " + std::to_string(w) + "x" + std::to_string(h) + " OpenGL window");
+      throw std::runtime_error("GLFW cannot open a " + std::to_string(w) + "x" + std::to_string(h) + " OpenGL window" +
+                               (o.mode == Mode::quad_buffer ? " with stereo buffers" : ""));
     }
     glfwMakeContextCurrent(window_);
     glfwSwapInterval(0);  // the game paces itself at --fps
@@ -288,7 +289,7 @@ class SdlGameWindow final : public GameWindow {
     SDL_GL_SetAttribute(SDL_GL_CONTEXT_MAJOR_VERSION, 2);
     SDL_GL_SetAttribute(SDL_GL_CONTEXT_MINOR_VERSION, 1);
     SDL_GL_SetAttribute(SDL_GL_DOUBLEBUFFER, 1);
-    // The quad-buffer mode (a stereo framebuffer, SDL_GL_STEREO) goes here.
+    SDL_GL_SetAttribute(SDL_GL_STEREO, o.mode == Mode::quad_buffer ? 1 : 0);
     window_ = SDL_CreateWindow(o.title.c_str(), SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, w, h,
                                SDL_WINDOW_OPENGL | SDL_WINDOW_RESIZABLE);
     if (!window_) {
@@ -330,10 +331,6 @@ struct FileCloser {
 };
 
 int run(const Options& o) {
-  if (o.mode == Mode::quad_buffer)
-    // The quad-buffer mode: a stereo framebuffer (the toolkit's stereo hint above), each eye drawn
-    // into GL_BACK_LEFT / GL_BACK_RIGHT with draw_eye over the whole window.
-    throw BadUsage("--mode quad-buffer is not in this version of the test game yet");
   std::unique_ptr<std::FILE, FileCloser> log;
   if (!o.log.empty()) {
     log.reset(std::fopen(o.log.c_str(), "w"));
@@ -369,7 +366,10 @@ int run(const Options& o) {
     if (o.mode == Mode::fp) fill(h, 0, 0, w, h, 0, 0, 0);  // the gap
     // The present time is taken last before drawing the stamp, right before the swap.
     const nelf::FrameStamp stamp{static_cast<std::uint32_t>(frame), now_ns()};
+    // Quad-buffer stereo: each eye over the whole window, into its own back buffer.
+    if (o.mode == Mode::quad_buffer) glDrawBuffer(GL_BACK_LEFT);
     draw_eye(left, h, frame, o.fps, -1, stamp);
+    if (o.mode == Mode::quad_buffer) glDrawBuffer(GL_BACK_RIGHT);
     draw_eye(right, h, frame, o.fps, +1, stamp);
     window->swap();
     if (log) std::fprintf(log.get(), "%ld,%lld\n", frame, static_cast<long long>(stamp.present_ns));

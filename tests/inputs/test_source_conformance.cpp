@@ -66,8 +66,8 @@ const std::map<std::string, std::function<DriverInputs(const TempDir&)>>& input_
 
 // Live rows read an X server, which unit tests do not have: their contract (info() against the
 // frames, no seek, one line for bad inputs) is checked against real windows in the window suite,
-// tests/inputs/window/test_x11_source.cpp.
-const std::vector<std::string> kLiveRows = {"x11"};
+// tests/inputs/window/test_x11_source.cpp and (a quad-buffer game's eyes) test_glx_stereo_source.cpp.
+const std::vector<std::string> kLiveRows = {"x11", "glx-stereo"};
 
 std::vector<std::string> driver_names() {
   std::vector<std::string> names;

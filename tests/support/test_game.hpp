@@ -15,7 +15,8 @@ namespace nelf::test {
 
 class TestGame {
  public:
-  explicit TestGame(const std::vector<std::string>& args) {
+  // `environment`: NAME=VALUE entries set for the game (the quad-buffer interposer's).
+  explicit TestGame(const std::vector<std::string>& args, const std::vector<std::string>& environment = {}) {
     std::vector<std::string> all{NELF_TEST_GAME};
     all.insert(all.end(), args.begin(), args.end());
     std::vector<char*> argv;
@@ -24,6 +25,7 @@ class TestGame {
     pid_ = fork();
     if (pid_ < 0) throw std::runtime_error("fork failed");
     if (pid_ == 0) {
+      for (const std::string& entry : environment) putenv(const_cast<char*>(entry.c_str()));
       execv(argv[0], argv.data());
       _exit(127);
     }

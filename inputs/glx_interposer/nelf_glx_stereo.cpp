@@ -1,0 +1,652 @@
+// nelf-glx-stereo.so: loaded into a game by `nelf run` (LD_PRELOAD), it gives OpenGL games that ask
+// for quad-buffer stereo what Mesa never offers: stereo visuals and FBConfigs, and a back buffer per
+// eye. Everything the game draws into GL_BACK_LEFT / GL_BACK_RIGHT goes into two framebuffer objects
+// of the window's size; at each swap both eyes are read into shared memory for nelf's `glx-stereo:`
+// source (inputs/glx_stereo_protocol.hpp), the left eye is copied into the window so that the game's
+// own window still shows its picture, and the real swap follows. A game that never draws into a
+// right buffer is left as it is (its window is captured instead).
+//
+// Games reach GLX and GL in three ways, all covered: by linking libGL (the symbols below win over
+// libGL's through LD_PRELOAD), through glXGetProcAddress(ARB) (GLFW, SDL2, libepoxy), and through
+// dlsym on a libGL handle they opened themselves (GLFW and SDL2 load libGL.so.1 that way, libepoxy
+// for GL 1.x): dlsym is interposed too and answers with these functions for the names they cover.
+//
+// The game's view of the default framebuffer is kept: binding framebuffer 0 binds the current eye's
+// object, and the bindings, draw and read buffers it queries are what it set. Drawing with GL_BACK
+// (both eyes) clears both eyes; other drawing with GL_BACK goes to the left eye only.
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/gl.h>
+#include <GL/glext.h>
+#include <GL/glx.h>
+#include <dlfcn.h>
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "inputs/glx_stereo_protocol.hpp"
+
+namespace {
+
+namespace protocol = nelf::glx_stereo;
+
+using DlsymFn = void* (*)(void*, const char*);
+
+// The real dlsym, found by version since dlsym itself is interposed (glibc 2.34 moved it).
+DlsymFn real_dlsym() {
+  static const DlsymFn fn = [] {
+    void* f = dlvsym(RTLD_NEXT, "dlsym", "GLIBC_2.34");
+    if (!f) f = dlvsym(RTLD_NEXT, "dlsym", "GLIBC_2.2.5");
+    return reinterpret_cast<DlsymFn>(f);
+  }();
+  return fn;
+}
+
+// libGL as the game would get it; its own handle, so that a game that loads libGL privately
+// (RTLD_LOCAL, as GLFW and SDL2 do) is served from the same library.
+void* libgl() {
+  static void* handle = dlopen("libGL.so.1", RTLD_LAZY | RTLD_LOCAL);
+  return handle;
+}
+
+void say(const char* line) { std::fprintf(stderr, "nelf-glx-stereo: %s\n", line); }
+
+template <typename Fn>
+Fn real_glx(const char* name) {
+  void* gl = libgl();
+  return gl ? reinterpret_cast<Fn>(real_dlsym()(gl, name)) : nullptr;
+}
+
+using GetProcFn = __GLXextFuncPtr (*)(const GLubyte*);
+GetProcFn real_get_proc() {
+  static const GetProcFn fn = real_glx<GetProcFn>("glXGetProcAddressARB");
+  return fn;
+}
+
+// A GL entry point of the current context's driver (core and extension functions alike).
+template <typename Fn>
+Fn real_gl(const char* name) {
+  const GetProcFn get = real_get_proc();
+  return get ? reinterpret_cast<Fn>(get(reinterpret_cast<const GLubyte*>(name))) : nullptr;
+}
+
+#define NELF_REAL_GLX(name) static const auto real_##name = real_glx<decltype(&::name)>(#name)
+#define NELF_REAL_GL(name) static const auto real_##name = real_gl<decltype(&::name)>(#name)
+
+std::int64_t monotonic_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
+}
+
+bool is_right(GLenum buffer) { return buffer == GL_BACK_RIGHT || buffer == GL_FRONT_RIGHT || buffer == GL_RIGHT; }
+bool is_both(GLenum buffer) { return buffer == GL_BACK || buffer == GL_FRONT || buffer == GL_FRONT_AND_BACK; }
+
+// The link to nelf: a stream socket and the shared slots the eyes are written into.
+class NelfLink {
+ public:
+  ~NelfLink() { close(); }
+
+  bool connected() const { return fd_ >= 0; }
+
+  // Connects and says hello; stereo links get shared memory for eyes of width × height. At most
+  // twice a second, so that a game without nelf listening loses nothing.
+  bool connect(bool stereo, std::uint32_t width, std::uint32_t height) {
+    const char* path = std::getenv(protocol::kSocketVariable);
+    if (!path || !*path || std::strlen(path) >= sizeof(sockaddr_un::sun_path)) return false;
+    const std::int64_t now = monotonic_ns();
+    if (now - last_try_ns_ < 500'000'000) return false;
+    last_try_ns_ = now;
+    const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (fd < 0) return false;
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::strcpy(address.sun_path, path);
+    if (::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
+      ::close(fd);
+      return false;
+    }
+    fd_ = fd;
+    protocol::Message hello;
+    hello.type = protocol::MessageType::hello;
+    hello.stereo = stereo ? 1 : 0;
+    hello.width = width;
+    hello.height = height;
+    int memory = -1;
+    if (stereo) {
+      bytes_ = protocol::shared_bytes(width, height);
+      memory = memfd_create("nelf-glx-stereo", MFD_CLOEXEC);
+      if (memory < 0 || ftruncate(memory, static_cast<off_t>(bytes_)) != 0) {
+        if (memory >= 0) ::close(memory);
+        close();
+        return false;
+      }
+      void* mapped = mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_SHARED, memory, 0);
+      if (mapped == MAP_FAILED) {
+        ::close(memory);
+        close();
+        return false;
+      }
+      shared_ = static_cast<unsigned char*>(mapped);
+      width_ = width;
+      height_ = height;
+    }
+    const bool sent = send(hello, memory);
+    if (memory >= 0) ::close(memory);  // nelf holds its own descriptor now
+    if (!sent) close();
+    return sent;
+  }
+
+  // The slot for `frame`, marked as being written; nullptr when not linked for stereo.
+  unsigned char* begin_slot(std::uint64_t frame) {
+    if (!shared_) return nullptr;
+    unsigned char* slot = shared_ + (frame % protocol::kSlots) * protocol::slot_stride(width_, height_);
+    auto* head = reinterpret_cast<protocol::SlotHeader*>(slot);
+    std::atomic_ref<std::uint64_t>(head->sequence).fetch_add(1, std::memory_order_acq_rel);  // odd: writing
+    return slot;
+  }
+
+  void end_slot(unsigned char* slot, std::uint64_t frame, std::int64_t swapped_ns) {
+    auto* head = reinterpret_cast<protocol::SlotHeader*>(slot);
+    head->frame = frame;
+    head->swapped_ns = swapped_ns;
+    std::atomic_ref<std::uint64_t>(head->sequence).fetch_add(1, std::memory_order_release);  // even: done
+    protocol::Message message;
+    message.type = protocol::MessageType::frame;
+    message.slot = static_cast<std::uint32_t>(frame % protocol::kSlots);
+    message.frame = frame;
+    message.swapped_ns = swapped_ns;
+    send(message, -1);
+  }
+
+  void close() {
+    if (shared_) munmap(shared_, bytes_);
+    shared_ = nullptr;
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+  }
+
+ private:
+  // Never blocks the game: a message nelf has no room for is dropped (nelf reads the newest frame
+  // anyway); a link nelf closed is closed here too.
+  bool send(const protocol::Message& message, int attached_fd) {
+    iovec io{const_cast<protocol::Message*>(&message), sizeof message};
+    msghdr header{};
+    header.msg_iov = &io;
+    header.msg_iovlen = 1;
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
+    if (attached_fd >= 0) {
+      header.msg_control = control;
+      header.msg_controllen = sizeof control;
+      cmsghdr* c = CMSG_FIRSTHDR(&header);
+      c->cmsg_level = SOL_SOCKET;
+      c->cmsg_type = SCM_RIGHTS;
+      c->cmsg_len = CMSG_LEN(sizeof(int));
+      std::memcpy(CMSG_DATA(c), &attached_fd, sizeof(int));
+    }
+    const int flags = MSG_NOSIGNAL | (attached_fd >= 0 ? 0 : MSG_DONTWAIT);
+    const ssize_t n = ::sendmsg(fd_, &header, flags);
+    if (n == static_cast<ssize_t>(sizeof message)) return true;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return true;
+    close();
+    return false;
+  }
+
+  int fd_ = -1;
+  unsigned char* shared_ = nullptr;
+  std::size_t bytes_ = 0;
+  std::uint32_t width_ = 0, height_ = 0;
+  std::int64_t last_try_ns_ = -1'000'000'000'000LL;
+};
+
+// What one context keeps for the window it draws into.
+struct Eyes {
+  bool active = false;    // the game drew into a right buffer: each eye has its own framebuffer
+  bool unusable = false;  // the framebuffers could not be made: the game runs in mono
+  Display* display = nullptr;
+  GLXDrawable drawable = 0;
+  GLuint fbo[2] = {0, 0}, color[2] = {0, 0}, depth[2] = {0, 0};
+  int width = 0, height = 0;
+  GLenum draw_buffer = GL_BACK, read_buffer = GL_BACK;  // as the game set them on "framebuffer 0"
+  GLuint game_draw_fbo = 0, game_read_fbo = 0;          // the game's own framebuffer objects, 0: ours
+  std::uint64_t swaps = 0;
+  NelfLink link;
+};
+
+std::mutex g_mutex;
+std::unordered_map<GLXContext, Eyes>& contexts() {
+  static std::unordered_map<GLXContext, Eyes> map;
+  return map;
+}
+thread_local Eyes* t_current = nullptr;
+// The mono verdict (glXSwapBuffers): said yet, and the swaps it waited for.
+bool g_said_mono = false;
+int g_mono_swaps = 0;
+std::int64_t g_first_swap_ns = 0;
+
+int eye_of(GLenum buffer) { return is_right(buffer) ? 1 : 0; }
+
+void bind_draw(const Eyes& e) {
+  NELF_REAL_GL(glBindFramebuffer);
+  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.game_draw_fbo ? e.game_draw_fbo : e.fbo[eye_of(e.draw_buffer)]);
+}
+void bind_read(const Eyes& e) {
+  NELF_REAL_GL(glBindFramebuffer);
+  real_glBindFramebuffer(GL_READ_FRAMEBUFFER, e.game_read_fbo ? e.game_read_fbo : e.fbo[eye_of(e.read_buffer)]);
+}
+
+bool drawable_size(const Eyes& e, int& width, int& height) {
+  NELF_REAL_GLX(glXQueryDrawable);
+  unsigned w = 0, h = 0;
+  real_glXQueryDrawable(e.display, e.drawable, GLX_WIDTH, &w);
+  real_glXQueryDrawable(e.display, e.drawable, GLX_HEIGHT, &h);
+  width = static_cast<int>(w);
+  height = static_cast<int>(h);
+  return width > 0 && height > 0;
+}
+
+// (Re)allocates both eyes' colour and depth-stencil storage at the window's size.
+bool allocate(Eyes& e, int width, int height) {
+  NELF_REAL_GL(glGetIntegerv);
+  NELF_REAL_GL(glBindRenderbuffer);
+  NELF_REAL_GL(glRenderbufferStorage);
+  NELF_REAL_GL(glBindFramebuffer);
+  NELF_REAL_GL(glFramebufferRenderbuffer);
+  NELF_REAL_GL(glCheckFramebufferStatus);
+  GLint renderbuffer = 0, draw = 0;
+  real_glGetIntegerv(GL_RENDERBUFFER_BINDING, &renderbuffer);
+  real_glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw);
+  bool complete = true;
+  for (int i = 0; i < 2; ++i) {
+    real_glBindRenderbuffer(GL_RENDERBUFFER, e.color[i]);
+    real_glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+    real_glBindRenderbuffer(GL_RENDERBUFFER, e.depth[i]);
+    real_glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, width, height);
+    real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.fbo[i]);
+    real_glFramebufferRenderbuffer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, e.color[i]);
+    real_glFramebufferRenderbuffer(GL_DRAW_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, e.depth[i]);
+    complete = complete && real_glCheckFramebufferStatus(GL_DRAW_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+  }
+  real_glBindRenderbuffer(GL_RENDERBUFFER, static_cast<GLuint>(renderbuffer));
+  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(draw));
+  e.width = width;
+  e.height = height;
+  return complete;
+}
+
+// The game drew into a right buffer for the first time: from now on each eye has its own
+// framebuffer, the left one starting with what the game drew into the window's back buffer.
+void activate(Eyes& e) {
+  NELF_REAL_GL(glGenFramebuffers);
+  NELF_REAL_GL(glGenRenderbuffers);
+  NELF_REAL_GL(glBindFramebuffer);
+  NELF_REAL_GL(glBlitFramebuffer);
+  NELF_REAL_GL(glReadBuffer);
+  NELF_REAL_GL(glDrawBuffer);
+  NELF_REAL_GL(glIsEnabled);
+  NELF_REAL_GL(glDisable);
+  NELF_REAL_GL(glEnable);
+  int width = 0, height = 0;
+  if (!real_glGenFramebuffers || !real_glBlitFramebuffer || !drawable_size(e, width, height)) {
+    say("the game's OpenGL has no framebuffer objects: it runs in mono, and nelf shows its window");
+    e.unusable = true;
+    return;
+  }
+  real_glGenFramebuffers(2, e.fbo);
+  real_glGenRenderbuffers(2, e.color);
+  real_glGenRenderbuffers(2, e.depth);
+  if (!allocate(e, width, height)) {
+    say("cannot make a framebuffer per eye: the game runs in mono, and nelf shows its window");
+    e.unusable = true;
+    real_glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    return;
+  }
+  const bool scissor = real_glIsEnabled(GL_SCISSOR_TEST);
+  real_glDisable(GL_SCISSOR_TEST);
+  real_glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  real_glReadBuffer(GL_BACK);
+  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.fbo[0]);
+  real_glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  if (scissor) real_glEnable(GL_SCISSOR_TEST);
+  for (int i = 0; i < 2; ++i) {
+    real_glBindFramebuffer(GL_FRAMEBUFFER, e.fbo[i]);
+    real_glDrawBuffer(GL_COLOR_ATTACHMENT0);
+    real_glReadBuffer(GL_COLOR_ATTACHMENT0);
+  }
+  e.active = true;
+  bind_draw(e);
+  bind_read(e);
+}
+
+// Both eyes into the next shared slot, rows bottom-up as GL reads them.
+void send_eyes(Eyes& e, std::int64_t swapped_ns) {
+  NELF_REAL_GL(glGetIntegerv);
+  NELF_REAL_GL(glPixelStorei);
+  NELF_REAL_GL(glBindBuffer);
+  NELF_REAL_GL(glBindFramebuffer);
+  NELF_REAL_GL(glReadPixels);
+  if (!e.link.connected() &&
+      !e.link.connect(true, static_cast<std::uint32_t>(e.width), static_cast<std::uint32_t>(e.height)))
+    return;
+  unsigned char* slot = e.link.begin_slot(e.swaps);
+  if (!slot) return;
+  GLint pack_buffer = 0, alignment = 0, row_length = 0, skip_rows = 0, skip_pixels = 0;
+  real_glGetIntegerv(GL_PIXEL_PACK_BUFFER_BINDING, &pack_buffer);
+  real_glGetIntegerv(GL_PACK_ALIGNMENT, &alignment);
+  real_glGetIntegerv(GL_PACK_ROW_LENGTH, &row_length);
+  real_glGetIntegerv(GL_PACK_SKIP_ROWS, &skip_rows);
+  real_glGetIntegerv(GL_PACK_SKIP_PIXELS, &skip_pixels);
+  real_glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  real_glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  real_glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  real_glPixelStorei(GL_PACK_SKIP_ROWS, 0);
+  real_glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
+  const std::size_t eye_bytes =
+      protocol::eye_bytes(static_cast<std::uint32_t>(e.width), static_cast<std::uint32_t>(e.height));
+  for (int i = 0; i < 2; ++i) {
+    real_glBindFramebuffer(GL_READ_FRAMEBUFFER, e.fbo[i]);
+    real_glReadPixels(0, 0, e.width, e.height, GL_RGBA, GL_UNSIGNED_BYTE, slot + protocol::kSlotHeader + i * eye_bytes);
+  }
+  real_glBindBuffer(GL_PIXEL_PACK_BUFFER, static_cast<GLuint>(pack_buffer));
+  real_glPixelStorei(GL_PACK_ALIGNMENT, alignment);
+  real_glPixelStorei(GL_PACK_ROW_LENGTH, row_length);
+  real_glPixelStorei(GL_PACK_SKIP_ROWS, skip_rows);
+  real_glPixelStorei(GL_PACK_SKIP_PIXELS, skip_pixels);
+  e.link.end_slot(slot, e.swaps, swapped_ns);
+}
+
+// The left eye into the window's back buffer: what the game's own window shows.
+void show_left_eye(const Eyes& e) {
+  NELF_REAL_GL(glBindFramebuffer);
+  NELF_REAL_GL(glDrawBuffer);
+  NELF_REAL_GL(glBlitFramebuffer);
+  NELF_REAL_GL(glIsEnabled);
+  NELF_REAL_GL(glDisable);
+  NELF_REAL_GL(glEnable);
+  const bool scissor = real_glIsEnabled(GL_SCISSOR_TEST);
+  real_glDisable(GL_SCISSOR_TEST);
+  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  real_glDrawBuffer(GL_BACK);
+  real_glBindFramebuffer(GL_READ_FRAMEBUFFER, e.fbo[0]);
+  real_glBlitFramebuffer(0, 0, e.width, e.height, 0, 0, e.width, e.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  if (scissor) real_glEnable(GL_SCISSOR_TEST);
+}
+
+// glXChooseVisual's list: GLX_STEREO (a flag without a value) removed.
+std::vector<int> without_stereo_flag(const int* attributes) {
+  std::vector<int> out;
+  for (const int* a = attributes; a && *a != None; ++a) {
+    const int name = *a;
+    if (name == GLX_STEREO) continue;
+    out.push_back(name);
+    const bool flag = name == GLX_USE_GL || name == GLX_RGBA || name == GLX_DOUBLEBUFFER;
+    if (!flag) out.push_back(*++a);
+  }
+  out.push_back(None);
+  return out;
+}
+
+// glXChooseFBConfig's list of pairs: the GLX_STEREO pair removed.
+std::vector<int> without_stereo_pair(const int* attributes) {
+  std::vector<int> out;
+  for (const int* a = attributes; a && *a != None; a += 2)
+    if (a[0] != GLX_STEREO) out.insert(out.end(), {a[0], a[1]});
+  out.push_back(None);
+  return out;
+}
+
+}  // namespace
+
+extern "C" {
+
+__attribute__((visibility("default"))) XVisualInfo* glXChooseVisual(Display* dpy, int screen, int* attributes) {
+  NELF_REAL_GLX(glXChooseVisual);
+  std::vector<int> list = without_stereo_flag(attributes);
+  return real_glXChooseVisual(dpy, screen, list.data());
+}
+
+__attribute__((visibility("default"))) GLXFBConfig* glXChooseFBConfig(Display* dpy, int screen, const int* attributes,
+                                                                      int* count) {
+  NELF_REAL_GLX(glXChooseFBConfig);
+  std::vector<int> list = without_stereo_pair(attributes);
+  return real_glXChooseFBConfig(dpy, screen, list.data(), count);
+}
+
+// Every double-buffered configuration is a stereo one: the interposer gives it a second back buffer.
+__attribute__((visibility("default"))) int glXGetFBConfigAttrib(Display* dpy, GLXFBConfig config, int attribute,
+                                                                int* value) {
+  NELF_REAL_GLX(glXGetFBConfigAttrib);
+  if (attribute != GLX_STEREO) return real_glXGetFBConfigAttrib(dpy, config, attribute, value);
+  return real_glXGetFBConfigAttrib(dpy, config, GLX_DOUBLEBUFFER, value);
+}
+
+__attribute__((visibility("default"))) int glXGetConfig(Display* dpy, XVisualInfo* visual, int attribute, int* value) {
+  NELF_REAL_GLX(glXGetConfig);
+  if (attribute != GLX_STEREO) return real_glXGetConfig(dpy, visual, attribute, value);
+  return real_glXGetConfig(dpy, visual, GLX_DOUBLEBUFFER, value);
+}
+
+__attribute__((visibility("default"))) Bool glXMakeContextCurrent(Display* dpy, GLXDrawable draw, GLXDrawable read,
+                                                                  GLXContext context) {
+  NELF_REAL_GLX(glXMakeContextCurrent);
+  const Bool ok = real_glXMakeContextCurrent(dpy, draw, read, context);
+  if (ok) {
+    std::lock_guard lock(g_mutex);
+    t_current = context ? &contexts()[context] : nullptr;
+    if (t_current) {
+      t_current->display = dpy;
+      t_current->drawable = draw;
+    }
+  }
+  return ok;
+}
+
+__attribute__((visibility("default"))) Bool glXMakeCurrent(Display* dpy, GLXDrawable drawable, GLXContext context) {
+  NELF_REAL_GLX(glXMakeCurrent);
+  const Bool ok = real_glXMakeCurrent(dpy, drawable, context);
+  if (ok) {
+    std::lock_guard lock(g_mutex);
+    t_current = context ? &contexts()[context] : nullptr;
+    if (t_current) {
+      t_current->display = dpy;
+      t_current->drawable = drawable;
+    }
+  }
+  return ok;
+}
+
+__attribute__((visibility("default"))) void glXDestroyContext(Display* dpy, GLXContext context) {
+  NELF_REAL_GLX(glXDestroyContext);
+  {
+    std::lock_guard lock(g_mutex);
+    auto it = contexts().find(context);
+    if (it != contexts().end()) {
+      if (t_current == &it->second) t_current = nullptr;
+      contexts().erase(it);  // its framebuffers go with the context
+    }
+  }
+  real_glXDestroyContext(dpy, context);
+}
+
+__attribute__((visibility("default"))) void glXSwapBuffers(Display* dpy, GLXDrawable drawable) {
+  NELF_REAL_GLX(glXSwapBuffers);
+  Eyes* e = t_current;
+  if (!e || !e->active || e->drawable != drawable) {
+    // A game that draws one picture: nelf is told once, and captures its window. Toolkits swap
+    // before the game draws, and games show a mono splash first: that verdict waits for 10 swaps
+    // and a second of them.
+    if (e && !e->active && !g_said_mono) {
+      const std::int64_t now = monotonic_ns();
+      if (g_mono_swaps++ == 0) g_first_swap_ns = now;
+      if (g_mono_swaps >= 10 && now - g_first_swap_ns >= 1'000'000'000) {
+        NelfLink once;
+        g_said_mono = once.connect(false, 0, 0);
+      }
+    }
+    real_glXSwapBuffers(dpy, drawable);
+    return;
+  }
+  const std::int64_t swapped_ns = monotonic_ns();
+  send_eyes(*e, swapped_ns);
+  show_left_eye(*e);
+  real_glXSwapBuffers(dpy, drawable);
+  ++e->swaps;
+  // A resized window: the eyes follow, and nelf is told the new size on a new link.
+  int width = 0, height = 0;
+  if (drawable_size(*e, width, height) && (width != e->width || height != e->height)) {
+    allocate(*e, width, height);
+    e->link.close();
+  }
+  bind_draw(*e);
+  bind_read(*e);
+}
+
+__attribute__((visibility("default"))) void glDrawBuffer(GLenum buffer) {
+  NELF_REAL_GL(glDrawBuffer);
+  Eyes* e = t_current;
+  if (e && !e->active && !e->unusable && is_right(buffer) && e->game_draw_fbo == 0) activate(*e);
+  if (!e || !e->active || e->game_draw_fbo != 0) return real_glDrawBuffer(buffer);
+  e->draw_buffer = buffer;
+  bind_draw(*e);
+  real_glDrawBuffer(buffer == GL_NONE ? GL_NONE : GL_COLOR_ATTACHMENT0);
+}
+
+__attribute__((visibility("default"))) void glDrawBuffers(GLsizei n, const GLenum* buffers) {
+  NELF_REAL_GL(glDrawBuffers);
+  Eyes* e = t_current;
+  if (e && e->game_draw_fbo == 0 && n >= 1) return glDrawBuffer(buffers[0]);  // one eye at a time
+  real_glDrawBuffers(n, buffers);
+}
+
+__attribute__((visibility("default"))) void glReadBuffer(GLenum buffer) {
+  NELF_REAL_GL(glReadBuffer);
+  Eyes* e = t_current;
+  if (!e || !e->active || e->game_read_fbo != 0) return real_glReadBuffer(buffer);
+  e->read_buffer = buffer;
+  bind_read(*e);
+  real_glReadBuffer(buffer == GL_NONE ? GL_NONE : GL_COLOR_ATTACHMENT0);
+}
+
+__attribute__((visibility("default"))) void glBindFramebuffer(GLenum target, GLuint framebuffer) {
+  NELF_REAL_GL(glBindFramebuffer);
+  Eyes* e = t_current;
+  if (e) {
+    if (target == GL_FRAMEBUFFER || target == GL_DRAW_FRAMEBUFFER) e->game_draw_fbo = framebuffer;
+    if (target == GL_FRAMEBUFFER || target == GL_READ_FRAMEBUFFER) e->game_read_fbo = framebuffer;
+  }
+  if (!e || !e->active || framebuffer != 0) return real_glBindFramebuffer(target, framebuffer);
+  if (target == GL_FRAMEBUFFER || target == GL_DRAW_FRAMEBUFFER) bind_draw(*e);
+  if (target == GL_FRAMEBUFFER || target == GL_READ_FRAMEBUFFER) bind_read(*e);
+}
+
+__attribute__((visibility("default"))) void glBindFramebufferEXT(GLenum target, GLuint framebuffer) {
+  glBindFramebuffer(target, framebuffer);
+}
+
+// What the game set, as it would read it from a real stereo framebuffer.
+__attribute__((visibility("default"))) void glGetIntegerv(GLenum name, GLint* data) {
+  NELF_REAL_GL(glGetIntegerv);
+  real_glGetIntegerv(name, data);
+  const Eyes* e = t_current;
+  if (name == GL_STEREO && e) *data = GL_TRUE;
+  if (!e || !e->active) return;
+  if (name == GL_DRAW_FRAMEBUFFER_BINDING) *data = static_cast<GLint>(e->game_draw_fbo);
+  if (name == GL_READ_FRAMEBUFFER_BINDING) *data = static_cast<GLint>(e->game_read_fbo);
+  if ((name == GL_DRAW_BUFFER || name == GL_DRAW_BUFFER0) && e->game_draw_fbo == 0)
+    *data = static_cast<GLint>(e->draw_buffer);
+  if (name == GL_READ_BUFFER && e->game_read_fbo == 0) *data = static_cast<GLint>(e->read_buffer);
+}
+
+__attribute__((visibility("default"))) void glGetBooleanv(GLenum name, GLboolean* data) {
+  NELF_REAL_GL(glGetBooleanv);
+  real_glGetBooleanv(name, data);
+  if (name == GL_STEREO && t_current) *data = GL_TRUE;
+}
+
+// A clear of both back buffers (GL_BACK on a stereo framebuffer) clears both eyes.
+__attribute__((visibility("default"))) void glClear(GLbitfield mask) {
+  NELF_REAL_GL(glClear);
+  NELF_REAL_GL(glBindFramebuffer);
+  Eyes* e = t_current;
+  if (!e || !e->active || e->game_draw_fbo != 0 || !is_both(e->draw_buffer)) return real_glClear(mask);
+  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e->fbo[1]);
+  real_glClear(mask);
+  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e->fbo[0]);
+  real_glClear(mask);
+}
+
+__GLXextFuncPtr glXGetProcAddressARB(const GLubyte* name);
+
+__attribute__((visibility("default"))) void (*glXGetProcAddress(const GLubyte* name))() {
+  return glXGetProcAddressARB(name);
+}
+
+__attribute__((visibility("default"))) void* dlsym(void* handle, const char* name) noexcept;
+
+}  // extern "C"
+
+namespace {
+
+// The functions above by name: what glXGetProcAddress and dlsym answer with instead of libGL's.
+void* interposed(const char* name) {
+  struct Entry {
+    const char* name;
+    void* function;
+  };
+  static const Entry table[] = {
+      {"glXChooseVisual", reinterpret_cast<void*>(&glXChooseVisual)},
+      {"glXChooseFBConfig", reinterpret_cast<void*>(&glXChooseFBConfig)},
+      {"glXGetFBConfigAttrib", reinterpret_cast<void*>(&glXGetFBConfigAttrib)},
+      {"glXGetConfig", reinterpret_cast<void*>(&glXGetConfig)},
+      {"glXMakeCurrent", reinterpret_cast<void*>(&glXMakeCurrent)},
+      {"glXMakeContextCurrent", reinterpret_cast<void*>(&glXMakeContextCurrent)},
+      {"glXDestroyContext", reinterpret_cast<void*>(&glXDestroyContext)},
+      {"glXSwapBuffers", reinterpret_cast<void*>(&glXSwapBuffers)},
+      {"glXGetProcAddress", reinterpret_cast<void*>(&glXGetProcAddress)},
+      {"glXGetProcAddressARB", reinterpret_cast<void*>(&glXGetProcAddressARB)},
+      {"glDrawBuffer", reinterpret_cast<void*>(&glDrawBuffer)},
+      {"glDrawBuffers", reinterpret_cast<void*>(&glDrawBuffers)},
+      {"glDrawBuffersARB", reinterpret_cast<void*>(&glDrawBuffers)},
+      {"glReadBuffer", reinterpret_cast<void*>(&glReadBuffer)},
+      {"glBindFramebuffer", reinterpret_cast<void*>(&glBindFramebuffer)},
+      {"glBindFramebufferEXT", reinterpret_cast<void*>(&glBindFramebufferEXT)},
+      {"glGetIntegerv", reinterpret_cast<void*>(&glGetIntegerv)},
+      {"glGetBooleanv", reinterpret_cast<void*>(&glGetBooleanv)},
+      {"glClear", reinterpret_cast<void*>(&glClear)},
+  };
+  if (!name || name[0] != 'g' || name[1] != 'l') return nullptr;
+  for (const Entry& entry : table)
+    if (std::strcmp(entry.name, name) == 0) return entry.function;
+  return nullptr;
+}
+
+}  // namespace
+
+extern "C" {
+
+__attribute__((visibility("default"))) __GLXextFuncPtr glXGetProcAddressARB(const GLubyte* name) {
+  if (void* ours = interposed(reinterpret_cast<const char*>(name))) return reinterpret_cast<__GLXextFuncPtr>(ours);
+  const GetProcFn real = real_get_proc();
+  return real ? real(name) : nullptr;
+}
+
+__attribute__((visibility("default"))) void* dlsym(void* handle, const char* name) noexcept {
+  void* found = real_dlsym()(handle, name);
+  if (!found) return nullptr;
+  void* ours = interposed(name);
+  return ours ? ours : found;
+}
+
+}  // extern "C"

@@ -1,0 +1,246 @@
+// The glx-stereo driver: a quad-buffer game's eyes as a live stereo source (glx_stereo_source.hpp).
+// Each frame is the newest the game swapped: older ones still in the socket are skipped, as a live
+// window's are, and a slot the game overwrote while it was copied is dropped and counted.
+#include <fmt/format.h>
+#include <poll.h>
+#include <sys/mman.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include "core/printable.hpp"
+#include "core/unix_socket.hpp"
+#include "core/user_error.hpp"
+#include "inputs/glx_stereo_protocol.hpp"
+#include "inputs/glx_stereo_source.hpp"
+#include "inputs/source.hpp"
+#include "inputs/view_bytes.hpp"
+
+namespace nelf {
+
+namespace protocol = glx_stereo;
+
+bool is_glx_stereo_spec(std::string_view input) { return input.starts_with("glx-stereo:"); }
+
+GlxStereoSpec parse_glx_stereo_spec(const std::string& input) {
+  GlxStereoSpec spec;
+  std::string_view rest = std::string_view(input).substr(std::strlen("glx-stereo:"));
+  // A path may hold commas: socket= takes the rest of the spec, so it comes last.
+  while (!rest.empty()) {
+    const std::size_t eq = rest.find('=');
+    if (eq == std::string_view::npos) throw UserError(fmt::format("{}: expected key=value (wait=, socket=)", input), 2);
+    const std::string_view key = rest.substr(0, eq);
+    if (key == "socket") {
+      spec.socket = std::string(rest.substr(eq + 1));
+      break;
+    }
+    const std::size_t comma = rest.find(',', eq);
+    const std::string value(
+        rest.substr(eq + 1, comma == std::string_view::npos ? std::string_view::npos : comma - eq - 1));
+    rest = comma == std::string_view::npos ? std::string_view() : rest.substr(comma + 1);
+    if (key != "wait") throw UserError(fmt::format("{}: unknown key {} (wait=, socket=)", input, key), 2);
+    char* end = nullptr;
+    spec.wait_s = std::strtod(value.c_str(), &end);
+    if (value.empty() || *end != '\0' || !(spec.wait_s > 0 && spec.wait_s <= 3600))
+      throw UserError(fmt::format("{}: wait= must be a time from 0 to 3600 seconds, got '{}'", input, value), 2);
+  }
+  if (spec.socket.empty()) throw UserError(fmt::format("{}: socket=PATH is missing", input), 2);
+  return spec;
+}
+
+std::string glx_stereo_library_path() {
+  namespace fs = std::filesystem;
+  if (const char* explicit_path = std::getenv("NELF_GLX_STEREO_LIBRARY"); explicit_path && *explicit_path)
+    return explicit_path;
+  std::error_code ec;
+  const fs::path executable = fs::read_symlink("/proc/self/exe", ec);
+  for (const fs::path& p : {ec ? fs::path() : executable.parent_path().parent_path() / "lib/nelf/nelf-glx-stereo.so",
+                            fs::path(NELF_GLX_STEREO_INSTALLED), fs::path(NELF_GLX_STEREO_BUILT)})
+    if (!p.empty() && fs::exists(p, ec)) return p.string();
+  return NELF_GLX_STEREO_INSTALLED;
+}
+
+namespace drivers {
+namespace {
+
+// One message, with the descriptor it carries (the hello's shared memory), or nothing when the
+// game closed the link.
+struct Received {
+  protocol::Message message;
+  UniqueFd attached;
+};
+
+std::optional<Received> receive(int fd, bool wait) {
+  Received r;
+  iovec io{&r.message, sizeof r.message};
+  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
+  msghdr header{};
+  header.msg_iov = &io;
+  header.msg_iovlen = 1;
+  header.msg_control = control;
+  header.msg_controllen = sizeof control;
+  const ssize_t n = ::recvmsg(fd, &header, MSG_CMSG_CLOEXEC | (wait ? MSG_WAITALL : MSG_DONTWAIT));
+  for (cmsghdr* c = CMSG_FIRSTHDR(&header); c; c = CMSG_NXTHDR(&header, c))
+    if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_RIGHTS) {
+      int attached = -1;
+      std::memcpy(&attached, CMSG_DATA(c), sizeof attached);
+      r.attached = UniqueFd(attached);
+    }
+  if (n != static_cast<ssize_t>(sizeof r.message) || r.message.magic != protocol::kMagic) return std::nullopt;
+  return r;
+}
+
+struct Unmap {
+  std::size_t bytes = 0;
+  void operator()(unsigned char* p) const { munmap(p, bytes); }
+};
+
+class GlxStereoSource final : public Source {
+ public:
+  explicit GlxStereoSource(const SourceRequest& r)
+      : input_(r.input), spec_(parse_glx_stereo_spec(r.input)), swap_(r.swap_eyes) {
+    const UniqueFd listener = listen_on_unix_socket(spec_.socket, input_);
+    struct RemoveSocket {
+      std::string path;
+      ~RemoveSocket() { ::unlink(path.c_str()); }
+    } remove{spec_.socket};
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(spec_.wait_s);
+    while (link_.get() < 0) {
+      if (r.stop && r.stop->load()) throw UserError("interrupted while waiting for the game's first frame", 130);
+      if (std::chrono::steady_clock::now() > until)
+        throw GameDidNotSwap(
+            fmt::format("{}: no OpenGL game swapped a frame in {:g} s", printable(input_), spec_.wait_s), 1);
+      pollfd p{listener.get(), POLLIN, 0};
+      if (::poll(&p, 1, 100) > 0) link_ = UniqueFd(::accept4(listener.get(), nullptr, nullptr, SOCK_CLOEXEC));
+    }
+    const timeval patience{5, 0};  // the interposer says hello as it connects
+    ::setsockopt(link_.get(), SOL_SOCKET, SO_RCVTIMEO, &patience, sizeof patience);
+    std::optional<Received> hello = receive(link_.get(), true);
+    if (!hello || hello->message.type != protocol::MessageType::hello)
+      throw UserError(fmt::format("{}: the game's interposer said something else than hello (another nelf version?)",
+                                  printable(input_)),
+                      1);
+    if (!hello->message.stereo)
+      throw GameDrawsOnePicture(
+          fmt::format("{}: the game draws one picture (never into GL_BACK_RIGHT)", printable(input_)), 1);
+    width_ = static_cast<int>(hello->message.width);
+    height_ = static_cast<int>(hello->message.height);
+    const std::size_t bytes = protocol::shared_bytes(hello->message.width, hello->message.height);
+    void* mapped = hello->attached.get() >= 0 && width_ > 0 && height_ > 0
+                       ? mmap(nullptr, bytes, PROT_READ, MAP_SHARED, hello->attached.get(), 0)
+                       : MAP_FAILED;
+    if (mapped == MAP_FAILED) throw UserError(fmt::format("{}: cannot map the game's frames", printable(input_)), 1);
+    shared_ = std::unique_ptr<unsigned char, Unmap>(static_cast<unsigned char*>(mapped), Unmap{bytes});
+    origin_ = std::chrono::steady_clock::now();
+    description_ = fmt::format("{}: a quad-buffer OpenGL game, two {}x{} eyes{}, live", input_, width_, height_,
+                               swap_ ? " swapped" : "");
+    if (!r.quiet) fmt::print(stderr, "nelf: {}\n", printable(description_));
+  }
+
+  SourceInfo info() const override {
+    SourceInfo info;
+    info.frame_rate = 60;  // what a game aims at; play measures the game's own period as it goes
+    info.live = true;
+    info.description = description_;
+    info.view = {width_, height_, static_cast<double>(width_) / height_};
+    return info;
+  }
+
+  std::optional<StereoVideoFrame> next() override {
+    for (;;) {
+      // The newest frame the game swapped; the ones before it are late already.
+      std::optional<protocol::Message> newest;
+      for (bool wait = true;;) {
+        if (interrupted_) return std::nullopt;
+        pollfd p{link_.get(), POLLIN, 0};
+        const int ready = ::poll(&p, 1, wait ? 50 : 0);
+        if (ready <= 0) {
+          if (newest || !wait) break;
+          continue;
+        }
+        std::optional<Received> r = receive(link_.get(), false);
+        if (!r) {
+          if (newest) break;
+          return std::nullopt;  // the game ended, or its window changed size (a new link follows)
+        }
+        if (r->message.type == protocol::MessageType::frame && r->message.slot < protocol::kSlots) newest = r->message;
+        wait = !newest;
+      }
+      if (!newest) continue;
+      if (std::optional<StereoVideoFrame> frame = copy(*newest)) return frame;
+      ++lost_;  // overwritten while copied: the next one is newer anyway
+    }
+  }
+
+  void interrupt() override { interrupted_ = true; }
+  std::int64_t lost_frames() const override { return lost_; }
+
+  ViewFormat negotiate(const ViewFormat& wanted) override {
+    const auto& [bx, by] = wanted.block;
+    const bool fits = bx >= 1 && by >= 1 && bx <= width_ && by <= height_;
+    block_ = fits ? wanted.block : std::array<int, 2>{1, 1};
+    return {block_};
+  }
+
+ private:
+  std::optional<StereoVideoFrame> copy(const protocol::Message& message) {
+    const auto w = static_cast<std::uint32_t>(width_), h = static_cast<std::uint32_t>(height_);
+    unsigned char* slot = shared_.get() + message.slot * protocol::slot_stride(w, h);
+    auto* head = reinterpret_cast<protocol::SlotHeader*>(slot);
+    const std::uint64_t before = std::atomic_ref<std::uint64_t>(head->sequence).load(std::memory_order_acquire);
+    if (before % 2 != 0 || head->frame != message.frame) return std::nullopt;
+    const std::size_t eye = protocol::eye_bytes(w, h);
+    const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(w) * 4;
+    // GL's rows are bottom-up: the view's top row is the last one.
+    const auto view = [&](int i) {
+      const unsigned char* rows = slot + protocol::kSlotHeader + static_cast<std::size_t>(i) * eye;
+      return rgba8_block_means(rows + (height_ - 1) * stride, -stride, width_, height_, block_);
+    };
+    StereoVideoFrame frame;
+    frame.bits = 8;
+    frame.left = view(swap_ ? 1 : 0);
+    frame.right = view(swap_ ? 0 : 1);
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (std::atomic_ref<std::uint64_t>(head->sequence).load(std::memory_order_relaxed) != before) return std::nullopt;
+    frame.width = width_;
+    frame.height = height_;
+    frame.block = block_;
+    frame.aspect = static_cast<double>(width_) / height_;
+    const auto now = std::chrono::steady_clock::now();
+    frame.pts_s = std::chrono::duration<double>(now - origin_).count();
+    frame.captured_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
+    return frame;
+  }
+
+  std::string input_;
+  GlxStereoSpec spec_;
+  bool swap_ = false;
+  UniqueFd link_;
+  std::unique_ptr<unsigned char, Unmap> shared_;
+  int width_ = 0, height_ = 0;
+  std::chrono::steady_clock::time_point origin_;
+  std::string description_;
+  std::atomic<bool> interrupted_{false};
+  std::int64_t lost_ = 0;
+  std::array<int, 2> block_{1, 1};
+};
+
+}  // namespace
+
+bool accepts_glx_stereo(const SourceRequest& request) { return is_glx_stereo_spec(request.input); }
+
+std::unique_ptr<Source> open_glx_stereo(const SourceRequest& request) {
+  if (request.layout)
+    throw UserError(fmt::format("--layout does not apply to {}: the game gives each eye on its own", request.input), 2);
+  return std::make_unique<GlxStereoSource>(request);
+}
+
+}  // namespace drivers
+}  // namespace nelf

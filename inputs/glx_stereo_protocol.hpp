@@ -1,0 +1,56 @@
+#pragma once
+// What the quad-buffer interposer (inputs/glx_interposer/, loaded into a game) and nelf's
+// `glx-stereo:` source say to each other over a Unix stream socket, and how the eyes lie in the
+// shared memory it passes. Plain C++ without nelf's other headers: the interposer includes it too.
+//
+// The game's side connects to $NELF_GLX_STEREO_SOCKET at its first buffer swap and sends a hello:
+// stereo (it drew into GL_BACK_RIGHT, so the interposer keeps each eye's back buffer) with a memfd
+// of kSlots frame slots attached (SCM_RIGHTS), or mono (then it closes: nelf captures the window).
+// Then one frame message per swap, naming the slot just written. The slots are written in turn and
+// guarded by a sequence number (odd while written), so that a reader that fell behind notices a slot
+// overwritten under it instead of showing a torn frame; the game never waits for nelf.
+#include <cstddef>
+#include <cstdint>
+
+namespace nelf::glx_stereo {
+
+inline constexpr std::uint32_t kMagic = 0x4e4c4631;  // "NLF1"
+inline constexpr int kSlots = 3;
+inline constexpr const char* kSocketVariable = "NELF_GLX_STEREO_SOCKET";
+
+enum class MessageType : std::uint32_t { hello = 1, frame = 2 };
+
+struct Message {
+  std::uint32_t magic = kMagic;
+  MessageType type = MessageType::hello;
+  std::uint32_t stereo = 0;  // hello: 1 when the game draws both eyes
+  std::uint32_t width = 0;   // hello: each eye's size in pixels
+  std::uint32_t height = 0;
+  std::uint32_t slot = 0;       // frame: the slot just written
+  std::uint64_t frame = 0;      // frame: the game's swap count, from 0
+  std::int64_t swapped_ns = 0;  // frame: CLOCK_MONOTONIC when the game asked to swap
+};
+static_assert(sizeof(Message) == 40);
+
+// The head of each slot; the left eye's RGBA rows follow at kSlotHeader, then the right eye's, each
+// width × height × 4 bytes, rows bottom-up (as glReadPixels gives them).
+struct SlotHeader {
+  std::uint64_t sequence;  // odd while the game writes the slot; atomic_ref'd on both sides
+  std::uint64_t frame;
+  std::int64_t swapped_ns;
+};
+inline constexpr std::size_t kSlotHeader = 64;
+
+inline std::size_t eye_bytes(std::uint32_t width, std::uint32_t height) {
+  return static_cast<std::size_t>(width) * height * 4;
+}
+// Slots start on page boundaries.
+inline std::size_t slot_stride(std::uint32_t width, std::uint32_t height) {
+  const std::size_t bytes = kSlotHeader + 2 * eye_bytes(width, height);
+  return (bytes + 4095) / 4096 * 4096;
+}
+inline std::size_t shared_bytes(std::uint32_t width, std::uint32_t height) {
+  return kSlots * slot_stride(width, height);
+}
+
+}  // namespace nelf::glx_stereo

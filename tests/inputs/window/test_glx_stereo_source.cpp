@@ -1,0 +1,132 @@
+// The glx-stereo: source against the test game in quad-buffer mode on a private Xvfb with Mesa, which
+// has no stereo visuals: without nelf's interposer the game cannot open its window; with it
+// (LD_PRELOAD, as `nelf run` starts games) both eyes arrive, each its own, frame after frame,
+// through GLFW and through SDL2. A game that draws one picture, and one that never swaps, are said.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/frame_stamp.hpp"
+#include "inputs/glx_stereo_protocol.hpp"
+#include "inputs/glx_stereo_source.hpp"
+#include "inputs/source_drivers.hpp"
+#include "support/source_requests.hpp"
+#include "support/test_game.hpp"
+#include "support/test_support.hpp"
+#include "support/xvfb.hpp"
+
+namespace nelf {
+namespace {
+
+using test::quiet_request;
+
+class GlxStereoSourceTest : public ::testing::Test {
+ protected:
+  std::string socket() const { return (dir_.path() / "game.sock").string(); }
+  std::vector<std::string> interposed() const {
+    return {"LD_PRELOAD=" + glx_stereo_library_path(), std::string(glx_stereo::kSocketVariable) + "=" + socket()};
+  }
+
+  test::XvfbServer xvfb_;
+  test::ScopedDisplay display_env_{xvfb_.display_name()};
+  test::TempDir dir_;
+};
+
+TEST_F(GlxStereoSourceTest, MesaHasNoStereoVisualsForTheGameWithoutTheInterposer) {
+  for (const char* toolkit : {"glfw", "sdl2"}) {
+    SCOPED_TRACE(toolkit);
+    test::TestGame game({"--toolkit", toolkit, "--mode", "quad-buffer", "--size", "320x180", "--frames", "3"});
+    ASSERT_TRUE(game.wait_exit(std::chrono::seconds(20)));
+    EXPECT_EQ(game.status(), 1);  // "cannot open … with stereo buffers" / "Couldn't find matching GLX visual"
+  }
+}
+
+TEST_F(GlxStereoSourceTest, AQuadBufferGameGivesBothEyesFrameAfterFrame) {
+  for (const char* toolkit : {"glfw", "sdl2"}) {
+    SCOPED_TRACE(toolkit);
+    test::TestGame game({"--toolkit", toolkit, "--mode", "quad-buffer", "--size", "320x180", "--fps", "30"},
+                        interposed());
+    auto source = open_source(quiet_request("glx-stereo:wait=20,socket=" + socket()));
+    const SourceInfo info = source->info();
+    EXPECT_TRUE(info.live);
+    EXPECT_FALSE(info.seekable);
+    EXPECT_EQ(info.view.width, 320);
+    EXPECT_EQ(info.view.height, 180);
+    std::optional<std::uint32_t> last;
+    int stamped = 0;
+    for (int i = 0; i < 12; ++i) {
+      const std::optional<StereoVideoFrame> f = source->next();
+      ASSERT_TRUE(f);
+      ASSERT_EQ(f->width, 320);
+      ASSERT_EQ(f->height, 180);
+      EXPECT_GT(f->captured_ns, 0);
+      // Each eye is its own: the bars stand at opposite disparities, so the views differ.
+      EXPECT_NE(f->left, f->right);
+      // Both eyes carry the same frame's stamp, upright (a flipped view reads as no stamp).
+      const auto left = read_frame_stamp(f->left.data(), f->width, f->height, f->bits);
+      const auto right = read_frame_stamp(f->right.data(), f->width, f->height, f->bits);
+      ASSERT_TRUE(left && right) << "frame " << i;
+      EXPECT_EQ(*left, *right);
+      if (last) {
+        EXPECT_GT(left->frame, *last);  // the newest frame each time, never one again
+      }
+      last = left->frame;
+      ++stamped;
+    }
+    EXPECT_EQ(stamped, 12);
+  }
+}
+
+TEST_F(GlxStereoSourceTest, SwapEyesSwapsTheGamesEyes) {
+  test::TestGame game({"--mode", "quad-buffer", "--size", "320x180", "--fps", "30"}, interposed());
+  SourceRequest request = quiet_request("glx-stereo:wait=20,socket=" + socket());
+  request.swap_eyes = true;
+  auto swapped = open_source(request);
+  const std::optional<StereoVideoFrame> a = swapped->next();
+  ASSERT_TRUE(a);
+  swapped.reset();
+  game.wait_exit(std::chrono::milliseconds(0));
+  // The bars of the left eye (eye_sign -1) stand left of the right eye's: the near bar's orange
+  // begins further left in the left eye. Here the views are swapped, so the first view's begins
+  // further right.
+  const auto first_orange = [](const std::vector<std::uint8_t>& view, int width, int row) {
+    for (int x = 0; x < width; ++x) {
+      const std::uint8_t* p = &view[(static_cast<std::size_t>(row) * width + x) * 4];
+      if (p[0] > 200 && p[1] > 80 && p[1] < 150 && p[2] < 90) return x;
+    }
+    return -1;
+  };
+  const int row = 90;  // the near bar spans rows 60..120 of 180
+  const int first = first_orange(a->left, a->width, row), second = first_orange(a->right, a->width, row);
+  ASSERT_GE(first, 0);
+  ASSERT_GE(second, 0);
+  EXPECT_GT(first, second);
+}
+
+TEST_F(GlxStereoSourceTest, AGameThatDrawsOnePictureOrNeverSwapsIsSaid) {
+  {
+    test::TestGame game({"--mode", "sbs", "--size", "320x180", "--fps", "30"}, interposed());
+    EXPECT_THROW(open_source(quiet_request("glx-stereo:wait=20,socket=" + socket())), GameDrawsOnePicture);
+  }
+  try {
+    open_source(quiet_request("glx-stereo:wait=0.5,socket=" + socket()));
+    FAIL() << "no game, yet a source";
+  } catch (const GameDidNotSwap& e) {
+    EXPECT_NE(std::string(e.what()).find("no OpenGL game swapped a frame in 0.5 s"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(socket()));  // nelf's socket is gone with the source
+  try {
+    open_source(quiet_request("glx-stereo:wait=1"));
+    FAIL() << "no socket, yet a source";
+  } catch (const UserError& e) {
+    EXPECT_EQ(e.status(), 2);
+    EXPECT_NE(std::string(e.what()).find("socket=PATH is missing"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(open_source(quiet_request("glx-stereo:socket=" + socket(), StereoLayout::sbs)), UserError);
+}
+
+}  // namespace
+}  // namespace nelf
