@@ -485,12 +485,12 @@ __attribute__((visibility("default"))) void glXSwapBuffers(Display* dpy, GLXDraw
   Eyes* e = t_current;
   if (!e || !e->active || e->drawable != drawable) {
     // A game that draws one picture: nelf is told once, and captures its window. Toolkits swap
-    // before the game draws, and games show a mono splash first: that verdict waits for 10 swaps
-    // and a second of them.
+    // before the game draws: that verdict waits for 5 swaps and a fifth of a second of them (a
+    // quad-buffer game draws both eyes from its first frame; nelf waits for the window meanwhile).
     if (e && !e->active && !g_said_mono) {
       const std::int64_t now = monotonic_ns();
       if (g_mono_swaps++ == 0) g_first_swap_ns = now;
-      if (g_mono_swaps >= 10 && now - g_first_swap_ns >= 1'000'000'000) {
+      if (g_mono_swaps >= 5 && now - g_first_swap_ns >= 200'000'000) {
         NelfLink once;
         g_said_mono = once.connect(false, 0, 0);
       }
