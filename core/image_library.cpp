@@ -3,31 +3,16 @@
 #include <dlfcn.h>
 #include <fmt/format.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <memory>
 
+#include "core/module_path.hpp"
 #include "core/oiio/module_api.hpp"
 
 namespace nelf::image_library {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Where the module may be, first found wins: $NELF_IMAGE_LIBRARY (an explicit file: tests, unusual
-// installs); beside the executable as installed (bin/../lib/nelf, so that a relocated install
-// works); the configured install prefix; the build tree (nelf run from its build directory).
-std::vector<fs::path> candidates() {
-  if (const char* explicit_path = std::getenv("NELF_IMAGE_LIBRARY"); explicit_path && *explicit_path)
-    return {explicit_path};
-  std::vector<fs::path> paths;
-  std::error_code ec;
-  const fs::path executable = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) paths.push_back(executable.parent_path().parent_path() / "lib" / "nelf" / "nelf-oiio.so");
-  paths.emplace_back(NELF_IMAGE_LIBRARY_INSTALLED);
-  paths.emplace_back(NELF_IMAGE_LIBRARY_BUILT);
-  return paths;
-}
 
 struct CloseLibrary {
   void operator()(void* handle) const { dlclose(handle); }
@@ -38,15 +23,8 @@ struct CloseLibrary {
 class Module {
  public:
   Module() {
-    const auto paths = candidates();
-    fs::path path = paths.front();
-    for (const fs::path& p : paths) {
-      std::error_code ec;
-      if (fs::exists(p, ec)) {
-        path = p;
-        break;
-      }
-    }
+    const fs::path path =
+        find_module("NELF_IMAGE_LIBRARY", "nelf-oiio.so", NELF_IMAGE_LIBRARY_INSTALLED, NELF_IMAGE_LIBRARY_BUILT);
     handle_.reset(dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE));
     if (!handle_) {
       std::string why = dlerror();

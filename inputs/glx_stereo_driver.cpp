@@ -11,10 +11,10 @@
 #include <atomic>
 #include <chrono>
 #include <cstring>
-#include <filesystem>
 #include <memory>
 #include <optional>
 
+#include "core/module_path.hpp"
 #include "core/printable.hpp"
 #include "core/unix_socket.hpp"
 #include "core/user_error.hpp"
@@ -56,15 +56,8 @@ GlxStereoSpec parse_glx_stereo_spec(const std::string& input) {
 }
 
 std::string glx_stereo_library_path() {
-  namespace fs = std::filesystem;
-  if (const char* explicit_path = std::getenv("NELF_GLX_STEREO_LIBRARY"); explicit_path && *explicit_path)
-    return explicit_path;
-  std::error_code ec;
-  const fs::path executable = fs::read_symlink("/proc/self/exe", ec);
-  for (const fs::path& p : {ec ? fs::path() : executable.parent_path().parent_path() / "lib/nelf/nelf-glx-stereo.so",
-                            fs::path(NELF_GLX_STEREO_INSTALLED), fs::path(NELF_GLX_STEREO_BUILT)})
-    if (!p.empty() && fs::exists(p, ec)) return p.string();
-  return NELF_GLX_STEREO_INSTALLED;
+  return find_module("NELF_GLX_STEREO_LIBRARY", "nelf-glx-stereo.so", NELF_GLX_STEREO_INSTALLED, NELF_GLX_STEREO_BUILT)
+      .string();
 }
 
 namespace drivers {

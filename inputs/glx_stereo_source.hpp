@@ -32,8 +32,7 @@ class GameDidNotSwap : public UserError {
   using UserError::UserError;
 };
 
-// Where nelf-glx-stereo.so is: beside the executable as installed (bin/../lib/nelf), the configured
-// prefix, or the build tree; $NELF_GLX_STEREO_LIBRARY names it explicitly.
+// Where nelf-glx-stereo.so is (core/module_path.hpp); $NELF_GLX_STEREO_LIBRARY names it explicitly.
 std::string glx_stereo_library_path();
 
 }  // namespace nelf
