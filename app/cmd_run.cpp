@@ -2,8 +2,9 @@
 // quad-buffer OpenGL game gets nelf's interposer (LD_PRELOAD) and its two eyes come from there (the
 // glx-stereo: source); a game that draws both eyes into one picture has the window its process
 // opens (its _NET_WM_PID, or the title --window names) captured live (the x11: source), its layout
-// detected as for a file or given by --layout. Either is played with play's options. nelf ends when the game does, with
-// the game's exit status; quitting nelf (q, closing its window, Ctrl-C) ends the game too.
+// detected as for a file or given by --layout. Either is played with play's options. nelf ends
+// when the game does, with the game's exit status; quitting nelf (q, closing its window, Ctrl-C)
+// ends the game too.
 #include <fmt/format.h>
 
 #include <sys/wait.h>

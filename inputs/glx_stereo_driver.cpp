@@ -148,14 +148,14 @@ class GlxStereoSource final : public Source {
 
   std::optional<StereoVideoFrame> next() override {
     for (;;) {
-      // The newest frame the game swapped; the ones before it are late already.
+      // The newest frame the game swapped: wait for one, then take the ones already sent after it
+      // (those before it are late already).
       std::optional<protocol::Message> newest;
-      for (bool wait = true;;) {
+      for (;;) {
         if (interrupted_) return std::nullopt;
         pollfd p{link_.get(), POLLIN, 0};
-        const int ready = ::poll(&p, 1, wait ? 50 : 0);
-        if (ready <= 0) {
-          if (newest || !wait) break;
+        if (::poll(&p, 1, newest ? 0 : 50) <= 0) {
+          if (newest) break;
           continue;
         }
         std::optional<Received> r = receive(link_.get(), false);
@@ -164,9 +164,7 @@ class GlxStereoSource final : public Source {
           return std::nullopt;  // the game ended, or its window changed size (a new link follows)
         }
         if (r->message.type == protocol::MessageType::frame && r->message.slot < protocol::kSlots) newest = r->message;
-        wait = !newest;
       }
-      if (!newest) continue;
       if (std::optional<StereoVideoFrame> frame = copy(*newest)) return frame;
       ++lost_;  // overwritten while copied: the next one is newer anyway
     }

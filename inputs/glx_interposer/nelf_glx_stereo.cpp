@@ -235,6 +235,17 @@ thread_local Eyes* t_current = nullptr;
 bool g_said_mono = false;
 int g_mono_swaps = 0;
 std::int64_t g_first_swap_ns = 0;
+NelfLink g_verdict;
+
+// This thread's context is now `context`, drawing into `drawable` (both make-current calls).
+void made_current(Display* display, GLXDrawable drawable, GLXContext context) {
+  std::lock_guard lock(g_mutex);
+  t_current = context ? &contexts()[context] : nullptr;
+  if (t_current) {
+    t_current->display = display;
+    t_current->drawable = drawable;
+  }
+}
 
 int eye_of(GLenum buffer) { return is_right(buffer) ? 1 : 0; }
 
@@ -442,28 +453,14 @@ __attribute__((visibility("default"))) Bool glXMakeContextCurrent(Display* dpy, 
                                                                   GLXContext context) {
   NELF_REAL_GLX(glXMakeContextCurrent);
   const Bool ok = real_glXMakeContextCurrent(dpy, draw, read, context);
-  if (ok) {
-    std::lock_guard lock(g_mutex);
-    t_current = context ? &contexts()[context] : nullptr;
-    if (t_current) {
-      t_current->display = dpy;
-      t_current->drawable = draw;
-    }
-  }
+  if (ok) made_current(dpy, draw, context);
   return ok;
 }
 
 __attribute__((visibility("default"))) Bool glXMakeCurrent(Display* dpy, GLXDrawable drawable, GLXContext context) {
   NELF_REAL_GLX(glXMakeCurrent);
   const Bool ok = real_glXMakeCurrent(dpy, drawable, context);
-  if (ok) {
-    std::lock_guard lock(g_mutex);
-    t_current = context ? &contexts()[context] : nullptr;
-    if (t_current) {
-      t_current->display = dpy;
-      t_current->drawable = drawable;
-    }
-  }
+  if (ok) made_current(dpy, drawable, context);
   return ok;
 }
 
@@ -491,8 +488,8 @@ __attribute__((visibility("default"))) void glXSwapBuffers(Display* dpy, GLXDraw
       const std::int64_t now = monotonic_ns();
       if (g_mono_swaps++ == 0) g_first_swap_ns = now;
       if (g_mono_swaps >= 5 && now - g_first_swap_ns >= 200'000'000) {
-        NelfLink once;
-        g_said_mono = once.connect(false, 0, 0);
+        g_said_mono = g_verdict.connect(false, 0, 0);  // at most twice a second until nelf hears it
+        g_verdict.close();
       }
     }
     real_glXSwapBuffers(dpy, drawable);

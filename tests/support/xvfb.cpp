@@ -111,7 +111,12 @@ XvfbServer::~XvfbServer() {
   }
 }
 
-bool XvfbServer::running() const { return pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) == 0; }
+// WNOWAIT: the destructor reaps it, as for a server that still runs.
+bool XvfbServer::running() const {
+  siginfo_t info{};
+  return pid_ > 0 && waitid(P_PID, static_cast<id_t>(pid_), &info, WEXITED | WNOHANG | WNOWAIT) == 0 &&
+         info.si_pid == 0;
+}
 
 void XvfbServer::kill_now() {
   if (pid_ <= 0) return;

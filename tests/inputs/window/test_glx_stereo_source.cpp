@@ -87,8 +87,6 @@ TEST_F(GlxStereoSourceTest, SwapEyesSwapsTheGamesEyes) {
   auto swapped = open_source(request);
   const std::optional<StereoVideoFrame> a = swapped->next();
   ASSERT_TRUE(a);
-  swapped.reset();
-  game.wait_exit(std::chrono::milliseconds(0));
   // The bars of the left eye (eye_sign -1) stand left of the right eye's: the near bar's orange
   // begins further left in the left eye. Here the views are swapped, so the first view's begins
   // further right.
