@@ -42,7 +42,7 @@ namespace {
 
 namespace protocol = nelf::glx_stereo;
 
-using DlsymFn = void* (*)(void*, const char*);
+using DlsymFn = void* (*)(void*, const char*) noexcept;
 
 // The real dlsym, found by version since dlsym itself is interposed (glibc 2.34 moved it).
 DlsymFn real_dlsym() {
@@ -639,11 +639,12 @@ __attribute__((visibility("default"))) __GLXextFuncPtr glXGetProcAddressARB(cons
   return real ? real(name) : nullptr;
 }
 
+// For RTLD_NEXT glibc finds the caller from the return address: the lookups that are not for these
+// functions end in a tail call (a jump, built with -foptimize-sibling-calls), so that the caller is
+// the game's code, not this library.
 __attribute__((visibility("default"))) void* dlsym(void* handle, const char* name) noexcept {
-  void* found = real_dlsym()(handle, name);
-  if (!found) return nullptr;
-  void* ours = interposed(name);
-  return ours ? ours : found;
+  if (void* ours = interposed(name); ours && real_dlsym()(handle, name)) return ours;
+  return real_dlsym()(handle, name);
 }
 
 }  // extern "C"

@@ -104,6 +104,18 @@ TEST_F(GlxStereoSourceTest, SwapEyesSwapsTheGamesEyes) {
   EXPECT_GT(first, second);
 }
 
+TEST_F(GlxStereoSourceTest, DlsymRtldNextStillMeansAfterTheCaller) {
+  // The interposer answers dlsym for GL's functions; anything else a game's code looks up, RTLD_NEXT
+  // included, resolves as without it (other overlays and wrappers in the game depend on that).
+  const auto plain = test::run_command(NELF_RTLD_NEXT_PROBE);
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  EXPECT_NE(plain.out.find("libc.so"), std::string::npos) << plain.out;
+  const auto preloaded =
+      test::run_command("LD_PRELOAD=" + test::shell_quote(glx_stereo_library_path()) + " " + NELF_RTLD_NEXT_PROBE);
+  ASSERT_EQ(preloaded.status, 0) << preloaded.err;
+  EXPECT_EQ(preloaded.out, glx_stereo_library_path() + "\n");
+}
+
 TEST_F(GlxStereoSourceTest, AGameThatDrawsOnePictureOrNeverSwapsIsSaid) {
   {
     test::TestGame game({"--mode", "sbs", "--size", "320x180", "--fps", "30"}, interposed());
