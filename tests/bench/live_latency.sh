@@ -12,6 +12,8 @@
 #   SECONDS  how long each game runs (default 10)
 #   OUTPUT   nelf's --output (default offscreen; window shows it in an Xvfb window)
 # With LATENCY_ARGS="…" more options go to nelf run (e.g. "--fsaa 0", "--profile lvt-prototype").
+# LATENCY_MODE=quad-buffer runs the game in quad-buffer stereo (its eyes through nelf's interposer)
+# instead of side by side in its window (sbs, the default; any mode of the test game).
 set -euo pipefail
 build=$(realpath "${1:-build}")
 seconds=${2:-10}
@@ -35,7 +37,7 @@ echo "game fps | nelf shown | latency median ms | latency p99 ms | game frames s
 for fps in 30 60; do
   # shellcheck disable=SC2086
   "$build/nelf" run --output "$output" --quiet --log-frames "$work/nelf$fps.csv" ${LATENCY_ARGS:-} -- \
-    "$build/tests/nelf-test-game" --mode sbs --size 1280x720 --fps "$fps" --duration "$seconds" \
+    "$build/tests/nelf-test-game" --mode "${LATENCY_MODE:-sbs}" --size 1280x720 --fps "$fps" --duration "$seconds" \
     --log "$work/game$fps.csv" 2>"$work/err$fps.txt" || { cat "$work/err$fps.txt" >&2; exit 1; }
   summary=$(tail -1 "$work/err$fps.txt")
   # Latency: nelf's present minus the game's, for each game frame when nelf first showed it. Share:
