@@ -47,6 +47,36 @@ Image composite_eye_image(const Profile& profile, Eye eye, const View& view,
   return std::move(eyes[static_cast<int>(eye)]);
 }
 
+// What the panel shows for `eye`: the composite of the profile without its defect map (the map is
+// taken out so that the defects, and their compensation, are applied once here, whatever the
+// compositor does with a map), then, for a panel with a map, the panel's defects over that
+// composite and over the compensated one. The sweep and the single simulation show the same panel.
+struct PanelImages {
+  Image clean;                       // a defect-free panel
+  Image uncompensated, compensated;  // with the defects (only for a profile with a map)
+  std::optional<EyeDefectPlan> plan;
+  const Image& shown(bool compensation) const { return !plan ? clean : compensation ? compensated : uncompensated; }
+};
+
+PanelImages panel_images(const Profile& profile, Eye eye, const View& view, const EyeMapping& rendering,
+                         double pupil_mm, bool compensation, std::shared_ptr<const DisparitySurface> depth = nullptr) {
+  Profile without_defects = profile;
+  without_defects.correction.defects.reset();
+  without_defects.correction.defect_map.clear();
+  without_defects.correction.defect_map_path.clear();
+  PanelImages panel;
+  panel.clean = composite_eye_image(without_defects, eye, view, std::move(depth));
+  if (const DefectMap* defects = profile.correction.defects.get()) {
+    DefectPlanOptions plan_options;
+    plan_options.pupil_mm = pupil_mm;
+    panel.plan = plan_defect_compensation(rendering, *defects, plan_options);
+    panel.uncompensated = defective_display(*defects, eye, panel.clean);
+    if (compensation)
+      panel.compensated = defective_display(*defects, eye, compensated_display(*panel.plan, panel.clean));
+  }
+  return panel;
+}
+
 struct SimulateArgs {
   std::string input;
   std::string profile = "hmz-t1";
@@ -194,7 +224,10 @@ void run_sweep(const SimulateArgs& args, const Profile& profile, Eye eye, const 
     Profile at_distance = profile;
     at_distance.screen.distance_mm = screen_mm;
     const EyeMapping rendering = make_eye_mapping(at_distance, eye, view.aspect());
-    const Image displayed = composite_eye_image(at_distance, eye, view);
+    // The panel's defects (and their compensation, planned for this distance) are in every row.
+    const PanelImages panel =
+        panel_images(at_distance, eye, view, rendering, base_eye.pupil_mm, !args.no_defect_compensation);
+    const Image& displayed = panel.shown(!args.no_defect_compensation);
     const EyeSimulator simulator(device_optics(at_distance, eye), rendering, view.image, options);
     map.y_ticks.push_back(fmt::format("{:g} D ({})", screen_d, distance_label(rendering.render_distance_mm)));
     auto& row = map.values.emplace_back();
@@ -320,28 +353,16 @@ void run_simulate(const SimulateArgs& args) {
   const std::optional<SceneDepth> scene =
       scene_reference ? std::optional<SceneDepth>(SceneDepth{eye_surface(input.known_depth), geometry}) : std::nullopt;
   const SceneDepth* scene_ptr = scene ? &*scene : nullptr;
-  // The defect-free display: the map is taken out of the profile here, so that the defects (and their
-  // compensation) are applied once, below, whatever the compositor does with a map.
-  Profile without_defects = profile;
-  without_defects.correction.defects.reset();
-  without_defects.correction.defect_map.clear();
-  without_defects.correction.defect_map_path.clear();
-  const Image clean = composite_eye_image(without_defects, eye, view, eye_surface(composite_depth));
-  const EyeSimulator simulator(device, rendering, view.image);
-
   // A panel with a defect map shows its defects, compensated unless asked not to; the retina and the
   // PSNR are of what it shows.
+  const PanelImages panel = panel_images(profile, eye, view, rendering, eye_model.pupil_mm,
+                                         !args.no_defect_compensation, eye_surface(composite_depth));
+  const EyeSimulator simulator(device, rendering, view.image);
   const DefectMap* defects = profile.correction.defects.get();
-  std::optional<EyeDefectPlan> plan;
-  Image uncompensated, compensated;
-  if (defects) {
-    DefectPlanOptions plan_options;
-    plan_options.pupil_mm = eye_model.pupil_mm;
-    plan = plan_defect_compensation(rendering, *defects, plan_options);
-    uncompensated = defective_display(*defects, eye, clean);
-    if (!args.no_defect_compensation) compensated = defective_display(*defects, eye, compensated_display(*plan, clean));
-  }
-  const Image& displayed = !defects ? clean : args.no_defect_compensation ? uncompensated : compensated;
+  const Image& clean = panel.clean;
+  const Image& uncompensated = panel.uncompensated;
+  const std::optional<EyeDefectPlan>& plan = panel.plan;
+  const Image& displayed = panel.shown(!args.no_defect_compensation);
   const SimulationResult result = simulator.simulate(displayed, eye_model, scene_ptr);
 
   // The regions of known depth as the retina sees them, each judged on its own.

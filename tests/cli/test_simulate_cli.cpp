@@ -1,10 +1,13 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "support/test_support.hpp"
@@ -158,6 +161,36 @@ TEST(SimulateCli, SweepWritesTableAndHeatmap) {
   const auto heatmap = image_size(f.dir / "sweep.png");
   EXPECT_GT(heatmap[0], 600);
   EXPECT_GT(heatmap[1], 300);
+}
+
+// The sweep shows the panel the single simulation shows: with a defect map, the defects in every
+// row, compensated unless --no-defect-compensation (the map planned for each screen distance).
+TEST(SimulateCli, SweepShowsThePanelsDefects) {
+  const auto psnr_at_the_screen = [](const Fixture& f, const std::string& args) {
+    const auto csv = f.dir / "sweep.csv";
+    const CommandResult r = f.simulate("--sweep " + shell_quote(csv.string()) + " " + args);
+    EXPECT_EQ(r.status, 0) << r.err;
+    const std::string table = read_file(csv);
+    const std::string row = "\n1,1000.0,1,1000.0,";  // the 1 m screen, the eye focused on it
+    const std::size_t at = table.find(row);
+    if (at == std::string::npos) {
+      ADD_FAILURE() << table;
+      return 0.0;
+    }
+    return std::stod(table.substr(at + row.size()));
+  };
+  std::string map;  // about 1 % of the left panel's pixels dead, on a lattice no bundle is all of
+  for (int y = 3; y < 180; y += 9)
+    for (int x = 5 + (y % 2) * 6; x < 320; x += 11) map += fmt::format("left {} {} dead\n", x, y);
+  const Fixture clean;
+  Fixture with_map("[correction]\ndefect_map = \"panel.defects\"\n");
+  write_file(with_map.dir / "panel.defects", map);
+  const double defect_free = psnr_at_the_screen(clean, "");
+  const double uncompensated = psnr_at_the_screen(with_map, "--no-defect-compensation");
+  const double compensated = psnr_at_the_screen(with_map, "");
+  EXPECT_LT(uncompensated, defect_free - 0.4);  // measured 28.87 dB against 29.63 (the small panel's resolution rules)
+  EXPECT_GT(compensated, uncompensated + 0.3);  // measured 29.41 dB
+  EXPECT_LT(compensated, defect_free);
 }
 
 TEST(SimulateCli, UnreadableImage) {
