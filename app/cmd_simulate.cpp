@@ -55,7 +55,8 @@ struct PanelImages {
   Image clean;                       // a defect-free panel
   Image uncompensated, compensated;  // with the defects (only for a profile with a map)
   std::optional<EyeDefectPlan> plan;
-  const Image& shown(bool compensation) const { return !plan ? clean : compensation ? compensated : uncompensated; }
+  bool compensation = false;  // whether the panel shows the compensated composite
+  const Image& shown() const { return !plan ? clean : compensation ? compensated : uncompensated; }
 };
 
 PanelImages panel_images(const Profile& profile, Eye eye, const View& view, const EyeMapping& rendering,
@@ -65,6 +66,7 @@ PanelImages panel_images(const Profile& profile, Eye eye, const View& view, cons
   without_defects.correction.defect_map.clear();
   without_defects.correction.defect_map_path.clear();
   PanelImages panel;
+  panel.compensation = compensation;
   panel.clean = composite_eye_image(without_defects, eye, view, std::move(depth));
   if (const DefectMap* defects = profile.correction.defects.get()) {
     DefectPlanOptions plan_options;
@@ -227,7 +229,7 @@ void run_sweep(const SimulateArgs& args, const Profile& profile, Eye eye, const 
     // The panel's defects (and their compensation, planned for this distance) are in every row.
     const PanelImages panel =
         panel_images(at_distance, eye, view, rendering, base_eye.pupil_mm, !args.no_defect_compensation);
-    const Image& displayed = panel.shown(!args.no_defect_compensation);
+    const Image& displayed = panel.shown();
     const EyeSimulator simulator(device_optics(at_distance, eye), rendering, view.image, options);
     map.y_ticks.push_back(fmt::format("{:g} D ({})", screen_d, distance_label(rendering.render_distance_mm)));
     auto& row = map.values.emplace_back();
@@ -362,7 +364,7 @@ void run_simulate(const SimulateArgs& args) {
   const Image& clean = panel.clean;
   const Image& uncompensated = panel.uncompensated;
   const std::optional<EyeDefectPlan>& plan = panel.plan;
-  const Image& displayed = panel.shown(!args.no_defect_compensation);
+  const Image& displayed = panel.shown();
   const SimulationResult result = simulator.simulate(displayed, eye_model, scene_ptr);
 
   // The regions of known depth as the retina sees them, each judged on its own.

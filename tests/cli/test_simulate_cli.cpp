@@ -179,7 +179,7 @@ TEST(SimulateCli, SweepShowsThePanelsDefects) {
     }
     return std::stod(table.substr(at + row.size()));
   };
-  std::string map;  // about 1 % of the left panel's pixels dead, on a lattice no bundle is all of
+  std::string map;  // about 1 % of the left panel's pixels dead, spread so that every bundle keeps healthy pixels
   for (int y = 3; y < 180; y += 9)
     for (int x = 5 + (y % 2) * 6; x < 320; x += 11) map += fmt::format("left {} {} dead\n", x, y);
   const Fixture clean;
