@@ -43,7 +43,7 @@ struct ConvertArgs : CommonArgs {
   bool no_audio = false, quiet = false, strict = false;
   bool burn_subs = false;
   std::string sub_file;
-  std::optional<double> sub_parallax;
+  std::optional<std::string> sub_parallax;
   std::string sub_stereo;
   std::string sid = "auto";
   std::vector<std::string> slang;
@@ -249,13 +249,18 @@ SubtitleStereo parse_sub_stereo(const std::string& value) {
                   2);
 }
 
-double parse_sub_parallax(const std::optional<double>& parallax) {
+SubtitleDepth parse_sub_parallax(const std::optional<std::string>& parallax) {
   constexpr double kMax = max_sub_parallax_percent;
-  const double value = parallax.value_or(0.0);
-  if (!std::isfinite(value) || std::abs(value) > kMax)
-    throw UserError(fmt::format("--sub-parallax must be -{0}..{0} (percent of the view width), got {1}", kMax, value),
+  if (!parallax) return {};
+  if (*parallax == "auto") return {true, auto_sub_margin_percent};
+  double value = 0.0;
+  const char* end = parallax->data() + parallax->size();
+  const auto [stop, error] = std::from_chars(parallax->data(), end, value);
+  if (parallax->empty() || error != std::errc() || stop != end || !std::isfinite(value) || std::abs(value) > kMax)
+    throw UserError(fmt::format("--sub-parallax must be -{0}..{0} (percent of the view width) or auto, got {1}", kMax,
+                                printable(*parallax)),
                     2);
-  return value;
+  return {false, value};
 }
 
 Signal resolve_signal(const Profile& profile, const std::string& name) {
@@ -440,7 +445,7 @@ void add_convert_command(CLI::App& app) {
                   "Video, with --burn-subs: the subtitle file (SRT, ASS/SSA, WebVTT, PGS .sup, VobSub .idx, ...)");
   cmd->add_option("--sub-parallax", args->sub_parallax,
                   "Video, with --burn-subs: the subtitles' depth in percent of the view width (positive = in front "
-                  "of the screen; default 0, on it)");
+                  "of the screen; default 0, on it), or auto: just in front of the picture beneath them");
   cmd->add_option("--sub-stereo", args->sub_stereo,
                   "Video, with --burn-subs: bitmap subtitles (PGS, DVB, VobSub) authored per eye, sbs (left eye's in "
                   "the left half) or tab (left eye's on top)");

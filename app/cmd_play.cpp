@@ -131,9 +131,9 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
   if (!info.still && (subtitles || !tracks.empty())) {
     options.subtitle_tracks = std::move(tracks);
     options.sub_stereo = sub_stereo;
-    options.sub_parallax_percent = parse_sub_parallax(args.sub_parallax);
+    options.sub_depth = parse_sub_parallax(args.sub_parallax);
     if (!args.sub_parallax && record.sub_parallax && std::abs(*record.sub_parallax) <= max_sub_parallax_percent) {
-      options.sub_parallax_percent = *record.sub_parallax;
+      options.sub_depth = {false, *record.sub_parallax};
       if (!args.quiet && subtitles)
         fmt::print(stderr, "nelf: subtitle depth {:g} % as last time (--sub-parallax overrides)\n",
                    *record.sub_parallax);
@@ -161,10 +161,11 @@ PlayResult play_entry(const PlayArgs& args, const CommonOptions& common, const s
     if (swapped || record.swap_eyes) left.swap_eyes = swapped;
     // A pair's second file is given each time (--right): only a one-file layout is remembered.
     if (common.layout && *common.layout != StereoLayout::pair) left.layout = args.layout;
-    // The depth the subtitles were left at, when it is not the default (given or set by keys).
-    if (result.sub_parallax_percent)
+    // The depth the subtitles were left at, when it is not the default (given or set by keys). Auto
+    // is asked for each time: the fixed depth remembered before stays for a play without it.
+    if (result.sub_depth && !result.sub_depth->follows_content)
       left.sub_parallax =
-          *result.sub_parallax_percent != 0 ? std::optional<double>(*result.sub_parallax_percent) : std::nullopt;
+          result.sub_depth->percent != 0 ? std::optional<double>(result.sub_depth->percent) : std::nullopt;
     watch_later.save(*key, left, warn);
   }
   return result;
@@ -315,7 +316,8 @@ void add_play_command(CLI::App& app) {
   cmd->add_option("--slang", args->slang, "Subtitle track by language, first match wins: eng,ger (as tagged)")
       ->delimiter(',');
   cmd->add_option("--sub-parallax", args->sub_parallax,
-                  "The subtitles' depth in percent of the view width (positive = in front of the screen; default 0)");
+                  "The subtitles' depth in percent of the view width (positive = in front of the screen; default 0), "
+                  "or auto: just in front of the picture beneath them");
   cmd->add_option("--sub-stereo", args->sub_stereo,
                   "Bitmap subtitles (PGS, DVB, VobSub) authored per eye: sbs (left eye's in the left half) or tab "
                   "(left eye's on top)");

@@ -14,6 +14,7 @@
 #include "inputs/stereo_layout.hpp"
 #include "inputs/subtitle_track.hpp"
 #include "optics/profile.hpp"
+#include "player/subtitle_depth.hpp"
 
 namespace nelf::app {
 
@@ -24,9 +25,10 @@ using nelf::UserError;
 // Throws UserError (status 2) naming the accepted values.
 std::optional<StereoLayout> parse_layout_option(const std::string& name);
 
-// --sub-parallax of play and convert --burn-subs (percent of the view width; unset: 0). Throws
-// UserError (status 2) beyond ±10 %, where the two copies no longer fuse into one.
-double parse_sub_parallax(const std::optional<double>& parallax);
+// --sub-parallax of play and convert --burn-subs: percent of the view width (unset: 0), or auto
+// (just in front of the content beneath). Throws UserError (status 2) for anything else and beyond
+// ±10 %, where the two copies no longer fuse into one.
+SubtitleDepth parse_sub_parallax(const std::optional<std::string>& parallax);
 
 // --sub-stereo of play and convert --burn-subs: "" (flat), sbs or tab. Throws UserError (status
 // 2) naming the accepted values.

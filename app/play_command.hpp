@@ -35,7 +35,7 @@ struct PlayArgs : CommonArgs {
   bool subtitles = false;
   bool no_subs = false;
   std::string sub_file;
-  std::optional<double> sub_parallax;
+  std::optional<std::string> sub_parallax;
   std::string sub_stereo;    // --sub-stereo: "" (flat), sbs or tab
   std::string sid = "auto";  // a track number, auto or no
   std::vector<std::string> slang;

@@ -157,6 +157,7 @@ void convert_video(const VideoConvertRequest& r) {
   std::promise<std::pair<int, int>> size_promise;
   auto size_future = size_promise.get_future();
 
+  SubtitleDepthFollower sub_depth;  // the decode thread's (--sub-parallax auto)
   // Decode thread: the source, limited by --frames / --duration.
   std::jthread decode([&] {
     try {
@@ -169,7 +170,8 @@ void convert_video(const VideoConvertRequest& r) {
           throw UserError(fmt::format("{}: the frame size changed mid-stream", r.input), 1);
         if (subtitles) {
           const auto [w, h] = subtitle_canvas(*frame);
-          draw_subtitles(*frame, subtitles->render(frame->pts_s, w, h, frame->aspect), r.burn_subs->parallax_percent);
+          const SubtitleBitmap subtitle = subtitles->render(frame->pts_s, w, h, frame->aspect);
+          draw_subtitles(*frame, subtitle, sub_depth.parallax(*frame, subtitle, r.burn_subs->depth));
         }
         if (!decoded.push(std::move(*frame))) return;
         // Not one frame more than --frames is asked of the source: a live one may wait long for it.

@@ -11,14 +11,16 @@
 #include "inputs/subtitle_track.hpp"
 #include "optics/profile.hpp"
 #include "player/input_files.hpp"
+#include "player/subtitle_depth.hpp"
 
 namespace nelf {
 
 // `--burn-subs`: a subtitle track drawn into both views of every frame before compositing.
 struct SubtitleBurn {
-  std::string file;               // --sub-file; "" = a subtitle file beside the input, else its own track
-  double parallax_percent = 0.0;  // --sub-parallax: of the view width, positive = in front of the screen
-  SubtitleStreamChoice stream;    // --sid, --slang
+  std::string file;  // --sub-file; "" = a subtitle file beside the input, else its own track
+  // --sub-parallax: of the view width, positive = in front of the screen (or, auto, of the content).
+  SubtitleDepth depth;
+  SubtitleStreamChoice stream;                   // --sid, --slang
   SubtitleStereo stereo = SubtitleStereo::flat;  // --sub-stereo
 };
 

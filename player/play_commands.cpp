@@ -214,7 +214,7 @@ void PlayCommands::start_views_screenshot() {
   ViewsShot shot{state_.current->pts_s, state_.swap_eyes, std::nullopt, options_.sub_stereo, 0.0};
   if (subtitles_ && subtitles_->shown && subtitle_track() > 0) {
     shot.subtitles = options_.subtitle_tracks[static_cast<std::size_t>(subtitle_index_)];
-    shot.sub_parallax_percent = subtitles_->parallax_percent;
+    shot.sub_parallax_percent = subtitles_->drawn_percent;
   }
   views_job_ = std::async(std::launch::async, [shot, reopen = options_.reopen_input, frame = state_.current] {
     return write_views_screenshot(shot, reopen, *frame);
@@ -369,10 +369,17 @@ std::optional<PlayEnd> PlayCommands::apply(Command command) {
       subtitles_->parallax_percent =
           std::clamp(subtitles_->parallax_percent + step, -max_sub_parallax_percent, max_sub_parallax_percent);
       decode_again_from_here();
-      say(fmt::format("subtitle depth {:+.2f} % ({})", subtitles_->parallax_percent.load(),
-                      subtitles_->parallax_percent > 0   ? "in front of the screen"
-                      : subtitles_->parallax_percent < 0 ? "behind the screen"
-                                                         : "on the screen"));
+      const double percent = subtitles_->parallax_percent;
+      if (subtitles_->follows_content)
+        say(fmt::format("subtitle depth auto, {:+.2f} % ({})", percent,
+                        percent > 0   ? "in front of the content"
+                        : percent < 0 ? "behind the content"
+                                      : "at the content's depth"));
+      else
+        say(fmt::format("subtitle depth {:+.2f} % ({})", percent,
+                        percent > 0   ? "in front of the screen"
+                        : percent < 0 ? "behind the screen"
+                                      : "on the screen"));
       break;
     }
     case Command::help: {

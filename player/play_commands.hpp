@@ -32,13 +32,22 @@ FrameCompositor::GridPattern calibration_grid_pattern();
 
 // What the decoder reads as it draws the subtitles into each frame, and the keys change: the track
 // (j J: null for none; replaced on the display's thread while the decoder holds the one it draws
-// with), whether they show (v) and their depth (r R), in percent of the view width.
+// with), whether they show (v) and their depth (r R), in percent of the view width: the parallax,
+// or with `follows_content` (--sub-parallax auto) how far in front of the content beneath. The
+// decoder leaves the parallax it drew the last frame's at in `drawn_percent` (a views screenshot
+// draws them the same).
 struct SubtitleControls {
-  SubtitleControls(std::shared_ptr<SubtitleTrack> first, double parallax)
-      : track(std::move(first)), parallax_percent(parallax) {}
+  SubtitleControls(std::shared_ptr<SubtitleTrack> first, SubtitleDepth depth)
+      : track(std::move(first)),
+        follows_content(depth.follows_content),
+        parallax_percent(depth.percent),
+        drawn_percent(depth.follows_content ? 0.0 : depth.percent) {}
+  SubtitleDepth depth() const { return {follows_content, parallax_percent}; }
   std::atomic<std::shared_ptr<SubtitleTrack>> track;
   std::atomic<bool> shown{true};
+  const bool follows_content;
   std::atomic<double> parallax_percent;
+  std::atomic<double> drawn_percent;
 };
 
 struct PlayState {

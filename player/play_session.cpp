@@ -16,15 +16,18 @@ namespace {
 
 // The subtitles drawn into each frame on the decode thread: the frame's pts after a seek as before,
 // and the view's compositing untouched (GL, the tables and the frames composited ahead alike).
-std::function<void(StereoVideoFrame&)> subtitle_drawing(const PlayerOptions& options,
-                                                        const SubtitleControls& controls) {
+std::function<void(StereoVideoFrame&)> subtitle_drawing(const PlayerOptions& options, SubtitleControls& controls) {
   if (!options.subtitles && options.subtitle_tracks.empty()) return {};
-  return [&controls](StereoVideoFrame& frame) {
+  // Shared: the decoder's function is copied; the follower keeps the line being read.
+  auto follower = std::make_shared<SubtitleDepthFollower>();
+  return [&controls, follower](StereoVideoFrame& frame) {
     const std::shared_ptr<SubtitleTrack> track = controls.track.load();
     if (!track || !controls.shown) return;
-    const double parallax = controls.parallax_percent;
     const auto [width, height] = subtitle_canvas(frame);
-    draw_subtitles(frame, track->render(frame.pts_s, width, height, frame.aspect), parallax);
+    const SubtitleBitmap subtitle = track->render(frame.pts_s, width, height, frame.aspect);
+    const double parallax = follower->parallax(frame, subtitle, controls.depth());
+    controls.drawn_percent = parallax;
+    draw_subtitles(frame, subtitle, parallax);
   };
 }
 
@@ -165,7 +168,7 @@ PlayResult PlaySession::finish(std::int64_t composited_ahead) {
   else if (state.current)
     result.position_s = state.current->pts_s;
   result.eyes_swapped = state.swap_eyes;
-  if (options.subtitles || !options.subtitle_tracks.empty()) result.sub_parallax_percent = subtitles.parallax_percent;
+  if (options.subtitles || !options.subtitle_tracks.empty()) result.sub_depth = subtitles.depth();
   return result;
 }
 

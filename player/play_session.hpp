@@ -68,7 +68,7 @@ struct PlaySession {
   FrameScheduler scheduler;
   const ViewFormat view_format;  // negotiated before the first frame is decoded
   FrameQueue queue;
-  SubtitleControls subtitles{options.subtitles, options.sub_parallax_percent};  // before the decoder, which reads them
+  SubtitleControls subtitles{options.subtitles, options.sub_depth};  // before the decoder, which reads them
   std::jthread decoder;
   // Unblocks the decoder before it is joined, however play ends (a live source may be waiting for
   // a frame).

@@ -25,6 +25,7 @@
 #include "player/key_bindings.hpp"
 #include "player/stepped_clock.hpp"
 #include "player/subtitle_choice.hpp"
+#include "player/subtitle_depth.hpp"
 
 namespace nelf {
 
@@ -51,9 +52,10 @@ struct PlayerOptions {
   // composited ahead are seen right after a key.
   bool on_screen_messages = true;
   // Drawn into both views of every frame as it is decoded (null: none), the left eye's copy
-  // sub_parallax_percent of the view width right of the right eye's.
+  // sub_depth's parallax (a fixed one, or just in front of the content beneath: --sub-parallax auto)
+  // of the view width right of the right eye's.
   std::shared_ptr<SubtitleTrack> subtitles;
-  double sub_parallax_percent = 0.0;
+  SubtitleDepth sub_depth;
   // What the subtitle track keys (j J) and the IPC's sid switch among (subtitle_tracks), the
   // bitmaps of each laid out as `sub_stereo` says; empty: the subtitles there are cannot change.
   std::vector<SubtitleTrackRef> subtitle_tracks;
@@ -96,8 +98,9 @@ struct PlayResult {
   // Where play stopped, in the movie's time (the target of a seek not yet shown); none when nothing
   // was shown.
   std::optional<double> position_s;
-  bool eyes_swapped = false;                   // the user swapped the eyes (key s) an odd number of times
-  std::optional<double> sub_parallax_percent;  // the subtitles' depth at the end (there were some)
+  bool eyes_swapped = false;  // the user swapped the eyes (key s) an odd number of times
+  // The subtitles' depth at the end (there were some): a fixed parallax, or auto's margin.
+  std::optional<SubtitleDepth> sub_depth;
 };
 
 // Plays `source` on `display` until the end of the file, q/Esc, the window closing or `*stop`

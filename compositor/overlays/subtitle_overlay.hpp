@@ -3,6 +3,7 @@
 // lenses like the movie, and at a depth: the two copies are shifted horizontally in opposite
 // directions, as a 3D Blu-ray player offsets its subtitle plane.
 #include <array>
+#include <optional>
 
 #include "core/frames.hpp"
 #include "core/subtitle_bitmap.hpp"
@@ -25,7 +26,25 @@ constexpr double max_sub_parallax_percent = 10.0;
 // `frame` (8 or 16 bits a channel), the left eye's copy `parallax_percent` of the view width to the
 // right of the right eye's: positive puts the text in front of the screen, 0 on it. A subtitle
 // authored per eye (SubtitleBitmap::right_rgba) gives each eye its own, shifted the same way. Parts shifted
-// out of a view are cut off. Throws std::invalid_argument when the sizes differ.
+// out of a view are cut off. A frame that carries its content's depth gets it with the text's in the
+// text's place (the depth-aware compositor then shows the text at its own depth, not at the depth of
+// what it covers). Throws std::invalid_argument when the sizes differ.
 void draw_subtitles(StereoVideoFrame& frame, const SubtitleBitmap& subtitle, double parallax_percent);
+
+// The view pixels a subtitle covers (either eye's picture, before any shift): [x0, x1) × [y0, y1).
+struct SubtitleBox {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  bool operator==(const SubtitleBox&) const = default;
+};
+std::optional<SubtitleBox> subtitle_box(const SubtitleBitmap& subtitle);
+
+// --sub-parallax auto: the parallax, in percent of the view width (as draw_subtitles takes it), of
+// the nearest content beneath a subtitle at `box` of views `view_width`×`view_height`, from both
+// views' disparity. Beneath: the box widened by as far as the two copies can move apart (half the
+// largest parallax each side), so that nothing the shifted text covers is missed. Nearest: the 95th
+// percentile of the known disparities there, so that a few mismatched pixels do not throw the text
+// forward. Nullopt where too little of that region has a known depth (flat, occluded, unmatched).
+std::optional<double> content_parallax_beneath(const StereoDisparity& disparity, const SubtitleBox& box, int view_width,
+                                               int view_height);
 
 }  // namespace nelf

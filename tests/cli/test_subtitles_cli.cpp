@@ -104,6 +104,26 @@ TEST_F(SubtitlesCli, ParallaxMovesTheTextInBothEyes) {
   EXPECT_GT(differing(on_screen, in_front, half, on_screen.width), 20);
 }
 
+// --sub-parallax auto on a movie of known depth: a textured surface 15 of each view's 320 pixels in
+// front of the screen (4.69 % of the width, cut from one picture in RGB so that no chroma rounding
+// moves it), estimated from the views. Just in front of it is 4.94 %, which the overlay draws as it
+// draws --sub-parallax 5 (the small panel's views are block means: 2 of their pixels to each
+// side): the same frame, byte for byte; on the screen or at 2 % it is not.
+TEST_F(SubtitlesCli, AutoPutsTheTextJustInFrontOfThePictureBeneath) {
+  make_media(dir_ / "deep.mp4",
+             "-f lavfi -i " +
+                 shell_quote("color=c=gray:s=352x180:r=10:d=0.5,format=rgb24,noise=alls=80:allf=t+u,gblur=sigma=0.8,"
+                             "split[a][b];[a]crop=320:180:0:0[l];[b]crop=320:180:15:0[r];[l][r]hstack") +
+                 " -c:v libx264 -preset ultrafast -crf 12 -pix_fmt yuv420p");
+  const std::string subs = "--burn-subs --sub-file " + q(dir_ / "lines.txt");
+  const Packed automatic = convert(dir_ / "deep.mp4", "auto.png", subs + " --sub-parallax auto");
+  EXPECT_EQ(automatic.rgb, convert(dir_ / "deep.mp4", "five.png", subs + " --sub-parallax 5").rgb);
+  const Packed on_screen = convert(dir_ / "deep.mp4", "zero.png", subs);
+  EXPECT_GT(differing(automatic, on_screen, 0, automatic.width), 20);
+  EXPECT_GT(differing(automatic, convert(dir_ / "deep.mp4", "two.png", subs + " --sub-parallax 2"), 0, automatic.width),
+            20);
+}
+
 TEST_F(SubtitlesCli, StartKeepsTheSubtitlesOnTheMoviesClock) {
   write_file(dir_ / "late.srt", "1\n00:00:00,500 --> 00:00:00,800\nLATE LINE\n\n");
   const std::string late = "--burn-subs --sub-file " + q(dir_ / "late.srt");
@@ -136,6 +156,10 @@ TEST_F(SubtitlesCli, BadSubtitleInputIsOneLineAndNoOutput) {
   expect_clean_failure(out_,
                        "convert " + q(dir_ / "embedded.mkv") + " " + out + tail + " --burn-subs --sub-parallax 50", 2,
                        "--sub-parallax must be -10..10");
+  for (const char* value : {"near", "1.5x", "nan", "''"})
+    expect_clean_failure(
+        out_, "convert " + q(dir_ / "embedded.mkv") + " " + out + tail + " --burn-subs --sub-parallax " + value, 2,
+        "--sub-parallax must be -10..10 (percent of the view width) or auto, got");
   const auto still = write_lavfi_still(dir_, "still.png", "testsrc2=s=640x180");
   expect_clean_failure(out_, "convert " + q(still) + " " + out + tail + " --burn-subs", 2, "--burn-subs is for video");
 }

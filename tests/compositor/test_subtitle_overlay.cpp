@@ -1,6 +1,7 @@
 // Subtitles drawn into both views: where each eye's copy lands for a parallax, and how it blends.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 
 #include "compositor/overlays/subtitle_overlay.hpp"
@@ -105,6 +106,92 @@ TEST(SubtitleOverlay, AnEmptySubtitleDrawsNothing) {
   draw_subtitles(frame, SubtitleBitmap{10, 10, {}, {}}, 3.0);
   EXPECT_EQ(frame.left, before.left);
   EXPECT_EQ(frame.right, before.right);
+}
+
+// A block of opaque white pixels [x0, x1) × [y0, y1), the rest transparent.
+SubtitleBitmap block(int width, int height, int x0, int y0, int x1, int y1) {
+  SubtitleBitmap s{width, height, std::vector<std::uint8_t>(static_cast<std::size_t>(width) * height * 4, 0), {}};
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) std::memset(&s.rgba[(static_cast<std::size_t>(y) * width + x) * 4], 255, 4);
+  return s;
+}
+
+// Both views' disparity maps, `width`×`height` map pixels, all at `d`.
+StereoDisparity flat_disparity(int width, int height, float d) {
+  ViewDisparity map{width, height, std::vector<float>(static_cast<std::size_t>(width) * height, d)};
+  return {map, map, DisparityOrigin::known};
+}
+
+void set_columns(ViewDisparity& map, int x0, int x1, float d) {
+  for (int y = 0; y < map.height; ++y)
+    for (int x = x0; x < x1; ++x) map.d[static_cast<std::size_t>(y) * map.width + x] = d;
+}
+
+TEST(SubtitleOverlay, TheBoxIsWhatEitherEyesPictureCovers) {
+  EXPECT_FALSE(subtitle_box(SubtitleBitmap{}));
+  EXPECT_FALSE(subtitle_box(block(40, 20, 0, 0, 0, 0)));  // all transparent
+  EXPECT_EQ(subtitle_box(block(40, 20, 5, 12, 30, 18)), (SubtitleBox{5, 12, 30, 18}));
+  SubtitleBitmap per_eye = block(40, 20, 10, 12, 20, 18);
+  per_eye.right_rgba = block(40, 20, 14, 11, 26, 17).rgba;
+  EXPECT_EQ(subtitle_box(per_eye), (SubtitleBox{10, 11, 26, 18}));
+}
+
+// The content beneath a line in a 200x100 view whose maps are half as fine (100x50): a plane 3 map
+// pixels in front (6 view pixels: 3 % of the width) behind the text, the rest 2 % behind.
+TEST(SubtitleOverlay, TheNearestContentBeneathIsInPercentOfTheViewWidth) {
+  StereoDisparity d = flat_disparity(100, 50, -2.f);
+  set_columns(d.left, 30, 70, 3.f);
+  set_columns(d.right, 30, 70, 3.f);
+  const SubtitleBox text{70, 80, 130, 95};  // view pixels 70..130: map columns 35..65
+  ASSERT_TRUE(content_parallax_beneath(d, text, 200, 100));
+  EXPECT_NEAR(*content_parallax_beneath(d, text, 200, 100), 3.0, 1e-6);
+  // A line over the far part alone: -2 map pixels, -4 view pixels, 2 % behind.
+  EXPECT_NEAR(*content_parallax_beneath(flat_disparity(100, 50, -2.f), text, 200, 100), -2.0, 1e-6);
+  // Within reach of the copies (half the largest parallax, 10 view pixels each side) it counts.
+  StereoDisparity beside = flat_disparity(100, 50, 0.f);
+  set_columns(beside.left, 66, 70, 4.f);  // view columns 132..140
+  set_columns(beside.right, 66, 70, 4.f);
+  EXPECT_NEAR(*content_parallax_beneath(beside, text, 200, 100), 4.0, 1e-6);
+  StereoDisparity far_beside = flat_disparity(100, 50, 0.f);
+  set_columns(far_beside.left, 72, 80, 4.f);  // view columns 144..160: out of reach
+  set_columns(far_beside.right, 72, 80, 4.f);
+  EXPECT_NEAR(*content_parallax_beneath(far_beside, text, 200, 100), 0.0, 1e-6);
+}
+
+TEST(SubtitleOverlay, AFewMismatchedPixelsDoNotThrowTheTextForward) {
+  StereoDisparity d = flat_disparity(100, 50, 1.f);
+  d.left.d[45 * 100 + 50] = 40.f;  // one wild match under the text
+  d.right.d[44 * 100 + 52] = 35.f;
+  EXPECT_NEAR(*content_parallax_beneath(d, {70, 80, 130, 95}, 200, 100), 1.0, 1e-6);
+}
+
+TEST(SubtitleOverlay, NoDepthBeneathWhereTooLittleIsKnown) {
+  const float nan = std::nanf("");
+  StereoDisparity d = flat_disparity(100, 50, nan);
+  EXPECT_FALSE(content_parallax_beneath(d, {70, 80, 130, 95}, 200, 100));
+  d.left.d[45 * 100 + 50] = 2.f;  // one pixel of hundreds: too little to say
+  EXPECT_FALSE(content_parallax_beneath(d, {70, 80, 130, 95}, 200, 100));
+  EXPECT_FALSE(content_parallax_beneath(StereoDisparity{}, {70, 80, 130, 95}, 200, 100));
+}
+
+// With the content's depth on the frame, the text's parallax replaces it where the text is (the
+// depth-aware compositor then shows the text at its own depth); the maps other frames share are
+// left as they were.
+TEST(SubtitleOverlay, TheTextsDepthGoesIntoTheFramesDisparity) {
+  StereoVideoFrame frame = grey_frame(200, 10, 8);
+  const auto shared = std::make_shared<const StereoDisparity>(flat_disparity(100, 5, -1.f));
+  frame.disparity = shared;
+  draw_subtitles(frame, block(200, 10, 100, 4, 110, 6), 10.0);  // 20 view pixels apart: 10 map pixels
+  ASSERT_NE(frame.disparity, shared);
+  EXPECT_EQ(shared->left.d, flat_disparity(100, 5, -1.f).left.d);
+  const auto at = [](const ViewDisparity& m, int x, int y) { return m.d[static_cast<std::size_t>(y) * m.width + x]; };
+  // Left copy at view columns 110..120 (map 55..60), right copy at 90..100 (map 45..50), rows 4..6 (map 2).
+  EXPECT_EQ(at(frame.disparity->left, 57, 2), 10.f);
+  EXPECT_EQ(at(frame.disparity->left, 50, 2), -1.f);
+  EXPECT_EQ(at(frame.disparity->left, 57, 0), -1.f);
+  EXPECT_EQ(at(frame.disparity->right, 47, 2), 10.f);
+  EXPECT_EQ(at(frame.disparity->right, 57, 2), -1.f);
+  EXPECT_EQ(frame.disparity->origin, DisparityOrigin::known);
 }
 
 }  // namespace

@@ -506,6 +506,38 @@ TEST_F(PlayerTest, ASubtitleCueShowsInBothEyesForItsTimeOnly) {
   EXPECT_GE(hidden, 40);  // v at the first frame: none of the cue's frames shows it
 }
 
+// --sub-parallax auto while playing: over a textured surface 15 of the views' 320 pixels in front of
+// the screen (estimated from the block means play decodes), the line is drawn where a fixed 5 %
+// draws it (4.94 %: just in front), frame after frame, and not where 2 % does.
+TEST_F(PlayerTest, AutoSubtitleDepthDrawsTheLineJustInFrontOfThePicture) {
+  const auto clip = test::make_media(
+      dir_ / "deep.mp4",
+      "-f lavfi -i " +
+          test::shell_quote("color=c=gray:s=352x180:r=30:d=1,format=rgb24,noise=alls=80:allf=t+u,gblur=sigma=0.8,"
+                            "split[a][b];[a]crop=320:180:0:0[l];[b]crop=320:180:15:0[r];[l][r]hstack") +
+          " -c:v libx264 -preset ultrafast -crf 12 -pix_fmt yuv420p");
+  test::write_file(dir_ / "line.srt", "1\n00:00:00,000 --> 00:00:01,000\nHELLO 3D WORLD\n\n");
+  PlayerOptions options = silent_options();
+  const auto played = [&](SubtitleDepth depth) {
+    options.subtitles = std::make_shared<SubtitleTrack>((dir_ / "line.srt").string(), 0.0);
+    options.sub_depth = depth;
+    return panels_played(clip, options);
+  };
+  const auto automatic = played({true, auto_sub_margin_percent});
+  const auto five = played({false, 5.0});
+  const auto two = played({false, 2.0});
+  int compared = 0;
+  for (const auto& [pts, eyes] : automatic) {
+    if (!five.count(pts) || !two.count(pts)) continue;
+    for (std::size_t e : {0u, 1u}) {
+      EXPECT_EQ(differing(eyes[e], five.at(pts)[e], 0.0f), 0) << "not at 5 % at " << pts << " s in eye " << e;
+      EXPECT_GT(differing(eyes[e], two.at(pts)[e], 0.05f), 5) << "at 2 % at " << pts << " s in eye " << e;
+    }
+    ++compared;
+  }
+  EXPECT_GE(compared, 20);
+}
+
 // j and J step through the subtitle tracks, off between the last and the first: j from the first of
 // two shows the second's words from then on, J the none.
 TEST_F(PlayerTest, JAndShiftJSwitchTheSubtitleTrackWhilePlaying) {
