@@ -4,7 +4,9 @@
 // clock at the signal's refresh rate, as it paces a window without vsync. It is what the player's
 // tests run on, and a way to time the whole play loop on a machine without a monitor — as mpv's
 // `--vo=null` and Monado's null compositor are. Keys come from stdin when it is a pipe or a file,
-// one per refresh, so that a session scripted as the bytes a terminal sends is deterministic.
+// one per refresh and none before the first frame is presented, so that a session scripted as the
+// bytes a terminal sends is deterministic: however long the input takes to open (a resumed movie
+// seeking on a loaded machine), `hq` shows the first frame before it quits.
 #include <fmt/format.h>
 #include <poll.h>
 #include <sys/stat.h>
@@ -69,10 +71,12 @@ class OffscreenDisplay final : public Display {
   void present() override {
     glFinish();
     gl::check_error("presenting the packed frame");
+    presented_ = true;
   }
   double refresh_hz() const override { return refresh_hz_; }
   bool vsync() const override { return false; }
   std::vector<KeyPress> poll_events() override {
+    if (!presented_) return {};
     if (keys_.empty()) read_keys();
     if (keys_.empty()) return {};
     std::vector<KeyPress> one{keys_.front()};
@@ -93,6 +97,7 @@ class OffscreenDisplay final : public Display {
   gl::Framebuffer packed_fbo_;
   double refresh_hz_ = 60.0;
   bool reading_keys_ = false;
+  bool presented_ = false;  // the scripted keys wait for the first frame
   TerminalKeyParser parser_;
   std::deque<KeyPress> keys_;
 
