@@ -230,6 +230,13 @@ void run_convert(const ConvertArgs& args) {
 
 }  // namespace
 
+double parse_number(std::string_view text, bool& ok) {
+  double value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  ok = ec == std::errc() && end == text.data() + text.size() && std::isfinite(value);
+  return value;
+}
+
 std::optional<int> parse_track_number(const std::string& value, const std::string& option) {
   if (value == "auto" || value == "no") return std::nullopt;
   int number = 0;
@@ -253,10 +260,9 @@ SubtitleDepth parse_sub_parallax(const std::optional<std::string>& parallax) {
   constexpr double kMax = max_sub_parallax_percent;
   if (!parallax) return {};
   if (*parallax == "auto") return {true, auto_sub_margin_percent};
-  double value = 0.0;
-  const char* end = parallax->data() + parallax->size();
-  const auto [stop, error] = std::from_chars(parallax->data(), end, value);
-  if (parallax->empty() || error != std::errc() || stop != end || !std::isfinite(value) || std::abs(value) > kMax)
+  bool ok = false;
+  const double value = parse_number(*parallax, ok);
+  if (!ok || std::abs(value) > kMax)
     throw UserError(fmt::format("--sub-parallax must be -{0}..{0} (percent of the view width) or auto, got {1}", kMax,
                                 printable(*parallax)),
                     2);

@@ -6,7 +6,6 @@
 // where the eye focuses best on each region.
 #include <fmt/format.h>
 #include <unistd.h>
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -99,13 +98,6 @@ struct SimulateArgs {
   bool swap_eyes = false;
   std::int64_t max_pixels = kDefaultMaxPixels;
 };
-
-double parse_number(std::string_view text, bool& ok) {
-  double value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  ok = ec == std::errc() && end == text.data() + text.size() && std::isfinite(value);
-  return value;
-}
 
 Vec2 parse_eye_offset(const std::string& text) {
   const auto comma = text.find(',');

@@ -5,6 +5,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "compositor/compositor.hpp"
 #include "core/pixel_limit.hpp"
@@ -24,6 +25,10 @@ using nelf::UserError;
 // The --layout option of convert and simulate: "auto" (nullopt: detect) or a layout name.
 // Throws UserError (status 2) naming the accepted values.
 std::optional<StereoLayout> parse_layout_option(const std::string& name);
+
+// The whole of `text` as a finite number (std::from_chars: no leading '+' or spaces); `ok` says
+// whether it was one.
+double parse_number(std::string_view text, bool& ok);
 
 // --sub-parallax of play and convert --burn-subs: percent of the view width (unset: 0), or auto
 // (just in front of the content beneath). Throws UserError (status 2) for anything else and beyond

@@ -38,11 +38,8 @@ double SubtitleDepthFollower::parallax(const StereoVideoFrame& frame, const Subt
     return std::clamp(percent, -max_sub_parallax_percent, max_sub_parallax_percent);
   };
   if (!depth.follows_content) return limited(depth.percent);
-  if (last_pts_ && (frame.pts_s < *last_pts_ || frame.pts_s - *last_pts_ > kSeekGapS)) {
-    const double content = line_content_;
-    reset();
-    line_content_ = content;  // a new line after the seek starts where the last one was
-  }
+  // A new line after the seek starts where the last one was (line_content_ is kept).
+  if (last_pts_ && (frame.pts_s < *last_pts_ || frame.pts_s - *last_pts_ > kSeekGapS)) reset();
   last_pts_ = frame.pts_s;
   const std::optional<SubtitleBox> box = subtitle_box(subtitle);
   if (!box) {

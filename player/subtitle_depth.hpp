@@ -28,7 +28,7 @@ struct SubtitleDepth {
 constexpr double auto_sub_margin_percent = 0.25;
 
 // One stream's follower, used by the thread that draws its subtitles (it keeps the line being read
-// and a matcher); `reset` after a seek.
+// and a matcher); it tells a seek by the frame times going back or jumping.
 class SubtitleDepthFollower {
  public:
   SubtitleDepthFollower();
@@ -40,9 +40,10 @@ class SubtitleDepthFollower {
   // over `frame` at: `depth.percent` itself when fixed, that much in front of the content beneath
   // when following it. Call before the subtitle is drawn into the frame's views.
   double parallax(const StereoVideoFrame& frame, const SubtitleBitmap& subtitle, const SubtitleDepth& depth);
-  void reset();
 
  private:
+  // Forgets the line being read and the last estimate; the depth of the last line stays.
+  void reset();
   std::unique_ptr<StereoMatcher> matcher_;
   std::optional<SubtitleBox> line_box_;  // the line being read (its box tells one line from the next)
   double line_content_ = 0.0;            // the nearest content beneath it so far, percent
