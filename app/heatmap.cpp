@@ -72,7 +72,12 @@ void write_heatmap_png(const Heatmap& map, const std::filesystem::path& path) {
   }
   if (!(lo < hi)) lo = std::isfinite(lo) ? lo - 1 : 0, hi = std::isfinite(hi) ? hi + 1 : 1;
 
-  constexpr int cell_w = 46, cell_h = 34, top = 60, bottom = 80, bar_gap = 30, bar_w = 24, right = 90;
+  for (const HeatmapLine& line : map.lines)
+    if (static_cast<int>(line.column_position.size()) != rows)
+      throw std::invalid_argument("heatmap: a line without one position per row");
+
+  constexpr int cell_w = 46, cell_h = 34, top = 60, bar_gap = 30, bar_w = 24, right = 90;
+  const int bottom = map.note.empty() ? 80 : 104;
   // Room for the longest row label at 14 px (about 8 px a character in DejaVu Sans), 130 px at least.
   std::size_t longest = 0;
   for (const std::string& tick : map.y_ticks) longest = std::max(longest, tick.size());
@@ -90,14 +95,35 @@ void write_heatmap_png(const Heatmap& map, const std::filesystem::path& path) {
       // Dark text on the light (yellow-green) end of the map, white on the dark end.
       const double luminance = 0.2126 * colour[0] + 0.7152 * colour[1] + 0.0722 * colour[2];
       const Colour ink = luminance > 0.45 ? Colour{0.f, 0.f, 0.f} : Colour{1.f, 1.f, 1.f};
-      canvas.text(x0 + cell_w / 2, y0 + cell_h / 2, std::isfinite(v) ? fmt::format("{:.0f}", v) : "-", 14,
-                  AlignX::center, AlignY::center, ink);
+      canvas.text(x0 + cell_w / 2, y0 + cell_h / 2,
+                  std::isfinite(v) ? fmt::format("{:.{}f}", v, map.value_decimals) : "-", 14, AlignX::center,
+                  AlignY::center, ink);
     }
     canvas.text(left - 8, top + r * cell_h + cell_h / 2, map.y_ticks[r], 14, AlignX::right);
   }
   for (int c = 0; c < columns; ++c)
     canvas.text(left + c * cell_w + cell_w / 2, top + plot_h + 14, map.x_ticks[c], 13, AlignX::center);
   canvas.text(left + plot_w / 2, top + plot_h + 50, map.x_label, 16, AlignX::center);
+  if (!map.note.empty()) canvas.text(left + plot_w / 2, top + plot_h + 80, map.note, 14, AlignX::center);
+
+  // Lines: a 3 px stroke per row at its position (clamped to the plot's edges), joined at the rows'
+  // common border; a row without a position (NaN) breaks the line.
+  for (const HeatmapLine& line : map.lines) {
+    const auto x_at = [&](double position) {
+      const double clamped = std::clamp(position, -0.5, columns - 0.5);
+      return left + static_cast<int>(std::lround((clamped + 0.5) * cell_w));
+    };
+    for (int r = 0; r < rows; ++r) {
+      const double position = line.column_position[r];
+      if (!std::isfinite(position)) continue;
+      const int x = x_at(position), y0 = top + r * cell_h;
+      canvas.rectangle(x - 1, y0 - 1, x + 2, y0 + cell_h + 2, line.colour);
+      if (r + 1 < rows && std::isfinite(line.column_position[r + 1])) {
+        const int next = x_at(line.column_position[r + 1]);
+        canvas.rectangle(std::min(x, next) - 1, y0 + cell_h - 1, std::max(x, next) + 2, y0 + cell_h + 2, line.colour);
+      }
+    }
+  }
   canvas.text(10, top - 14, map.y_label, 16, AlignX::left);
 
   // Colour bar: top = highest value.
