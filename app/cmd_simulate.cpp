@@ -14,6 +14,7 @@
 #include <system_error>
 
 #include <fmt/ranges.h>
+#include "analysis/comfort_zone.hpp"
 #include "analysis/defect_visibility.hpp"
 #include "analysis/eye_simulator.hpp"
 #include "analysis/focus_sweep.hpp"
@@ -176,10 +177,17 @@ SimulatedInput load_simulated_input(const SimulateArgs& args, const StillOptions
   return in;
 }
 
-// A sweep's heatmap (beside the table, as .png) and then its table: a failure leaves neither
-// half-written.
-void write_sweep(const Heatmap& map, const std::string& csv, const std::filesystem::path& csv_path, const char* what) {
+// The heatmap of a sweep's gain beside its table: TABLE.gain.png.
+std::filesystem::path gain_heatmap_path(const std::string& csv_path) {
+  return std::filesystem::path(csv_path).replace_extension(".gain.png");
+}
+
+// A sweep's heatmap (beside the table, as .png; `gain` as .gain.png) and then its table: a failure
+// leaves none of them half-written.
+void write_sweep(const Heatmap& map, const std::string& csv, const std::filesystem::path& csv_path, const char* what,
+                 const Heatmap* gain = nullptr) {
   write_heatmap_png(map, std::filesystem::path(csv_path).replace_extension(".png"));
+  if (gain) write_heatmap_png(*gain, gain_heatmap_path(csv_path));
   try {
     write_file_atomically(csv_path, true, [&](const std::filesystem::path& temporary) {
       std::ofstream out(temporary, std::ios::binary);
@@ -192,51 +200,117 @@ void write_sweep(const Heatmap& map, const std::string& csv, const std::filesyst
   }
 }
 
+// The depth the composite follows (--depth): the source's own where it knows it (auto), else the
+// stereo matcher's estimate (null when the pair cannot be matched); none when off.
+std::shared_ptr<const StereoDisparity> composite_depth_of(DepthMode mode, const SimulatedInput& input) {
+  if (mode == DepthMode::off) return nullptr;
+  if (mode == DepthMode::automatic && input.known_depth) return input.known_depth;
+  return estimate_still_disparity(input.pair);
+}
+
+std::shared_ptr<const DisparitySurface> eye_surface(Eye eye, const std::shared_ptr<const StereoDisparity>& d) {
+  return d ? std::make_shared<const DisparitySurface>(eye == Eye::left ? d->left : d->right) : nullptr;
+}
+
+// What the sweep composites and compares with, as the single simulation does (--depth, --reference).
+struct SweepSetUp {
+  const SimulatedInput& input;
+  const StillOptions& still;
+  DepthMode depth_mode;
+  std::shared_ptr<const StereoDisparity> still_depth;  // a still's (its disparities do not change with the screen)
+  bool scene_reference;
+};
+
 // PSNR over screen distance × accommodation, both in diopters (0 D = infinity for accommodation).
 // Affordable on two cores: 1.5 retinal samples per display footprint and 5×5 pupil samples (the single
-// simulation uses 3 and 7×7); each screen distance is composited once.
-void run_sweep(const SimulateArgs& args, const Profile& profile, Eye eye, const View& view, const EyeModel& base_eye,
-               const std::filesystem::path& csv_path) {
+// simulation uses 3 and 7×7); each screen distance is composited once. A synthetic scene is filmed
+// again for each screen distance, so that every row shows the same real scene (its depths in
+// millimetres fixed, its disparities those of that screen); against it (--reference scene) the rows
+// show what following the content's depth gains over the flat screen: with --depth, each cell is
+// also simulated on the flat screen and the gain has a heatmap of its own. Each row marks the focus
+// that is comfortable while the eyes converge on the screen (Shibata et al.'s zone of comfort).
+void run_sweep(const SimulateArgs& args, const Profile& profile, Eye eye, const SweepSetUp& set_up,
+               const EyeModel& base_eye, const std::filesystem::path& csv_path) {
   const std::vector<double> screen_diopters{4.0, 3.5, 3.0, 2.5, 2.0, 1.5, 1.0, 0.5, 0.25};  // rows, near at top
+  constexpr double accommodation_step = 0.25;
   std::vector<double> accommodation_diopters;
-  for (int k = 0; k <= 16; ++k) accommodation_diopters.push_back(0.25 * k);
+  for (int k = 0; k <= 16; ++k) accommodation_diopters.push_back(accommodation_step * k);
   SimulatorOptions options;
   options.samples_per_footprint = 1.5;
   EyeModel sweep_eye = base_eye;
   sweep_eye.pupil_samples_per_axis = 5;
+  const bool refilmed = is_synthetic_spec(args.input);
 
   Heatmap map;
-  map.title =
-      fmt::format("PSNR of the {} eye vs. a real screen: {}, pupil {:g} mm", args.eye, profile.name, base_eye.pupil_mm);
+  map.title = fmt::format("PSNR of the {} eye vs. {}: {}, depth {}, pupil {:g} mm", args.eye,
+                          set_up.scene_reference ? "the real scene" : "a real screen at the row's distance",
+                          profile.name, depth_mode_name(set_up.depth_mode), base_eye.pupil_mm);
   map.x_label = "accommodation (diopters, 0 = infinity)";
   map.y_label = "screen distance";
   map.value_label = "PSNR dB";
+  map.note = "red: zone of comfort for the eyes converged on the screen (Shibata et al. 2011)";
+  map.lines.resize(2);
+  HeatmapLine &far_end = map.lines[0], &near_end = map.lines[1];
   for (double a : accommodation_diopters) map.x_ticks.push_back(fmt::format("{:g}", a));
-  std::string csv = "screen_diopters,screen_mm,accommodation_diopters,accommodation_mm,psnr_db,psnr_full_screen_db\n";
+  std::string csv =
+      "screen_diopters,screen_mm,accommodation_diopters,accommodation_mm,psnr_db,psnr_full_screen_db,"
+      "comfort_zone,psnr_flat_db,gain_db\n";
+  const bool with_depth = set_up.depth_mode != DepthMode::off;
+  Heatmap gain = map;
+  gain.title = fmt::format(
+      "Gain of depth {} over the flat screen vs. {}: {}, {} eye, pupil {:g} mm", depth_mode_name(set_up.depth_mode),
+      set_up.scene_reference ? "the real scene" : "a real screen", profile.name, args.eye, base_eye.pupil_mm);
+  gain.value_label = "gain dB";
+  gain.value_decimals = 1;
   for (double screen_d : screen_diopters) {
     const double screen_mm = 1000.0 / screen_d;
     Profile at_distance = profile;
     at_distance.screen.distance_mm = screen_mm;
+    std::optional<SimulatedInput> refilmed_input;
+    if (refilmed) refilmed_input = load_simulated_input(args, set_up.still, at_distance);
+    const SimulatedInput& input = refilmed ? *refilmed_input : set_up.input;
+    const View& view = input.view(eye);
     const EyeMapping rendering = make_eye_mapping(at_distance, eye, view.aspect());
+    const std::shared_ptr<const StereoDisparity> depth =
+        refilmed ? composite_depth_of(set_up.depth_mode, input) : set_up.still_depth;
+    const std::optional<SceneDepth> scene =
+        set_up.scene_reference ? std::optional<SceneDepth>(SceneDepth{eye_surface(eye, input.known_depth),
+                                                                      depth_geometry(at_distance, rendering)})
+                               : std::nullopt;
     // The panel's defects (and their compensation, planned for this distance) are in every row.
-    const PanelImages panel =
-        panel_images(at_distance, eye, view, rendering, base_eye.pupil_mm, !args.no_defect_compensation);
+    const PanelImages panel = panel_images(at_distance, eye, view, rendering, base_eye.pupil_mm,
+                                           !args.no_defect_compensation, eye_surface(eye, depth));
     const Image& displayed = panel.shown();
+    // The same panel on the flat screen, for the gain (the depth-aware one itself where there is no depth).
+    std::optional<PanelImages> flat_panel;
+    if (depth)
+      flat_panel = panel_images(at_distance, eye, view, rendering, base_eye.pupil_mm, !args.no_defect_compensation);
     const EyeSimulator simulator(device_optics(at_distance, eye), rendering, view.image, options);
     map.y_ticks.push_back(fmt::format("{:g} D ({})", screen_d, distance_label(rendering.render_distance_mm)));
+    const AccommodationRange comfortable = comfortable_accommodation(1000.0 / rendering.render_distance_mm);
+    far_end.column_position.push_back(comfortable.farthest_diopters / accommodation_step);
+    near_end.column_position.push_back(comfortable.nearest_diopters / accommodation_step);
     auto& row = map.values.emplace_back();
+    auto& gain_row = gain.values.emplace_back();
     for (double accommodation_d : accommodation_diopters) {
       sweep_eye.focus_mm = accommodation_d > 0.0 ? 1000.0 / accommodation_d : infinity;
-      const SimulationResult r = simulator.simulate(displayed, sweep_eye);
+      const SimulationResult r = simulator.simulate(displayed, sweep_eye, scene ? &*scene : nullptr);
+      const double flat_db = flat_panel
+                                 ? simulator.simulate(flat_panel->shown(), sweep_eye, scene ? &*scene : nullptr).psnr_db
+                                 : r.psnr_db;
       row.push_back(r.psnr_db);
+      gain_row.push_back(r.psnr_db - flat_db);
       csv += fmt::format(
-          "{:g},{:.1f},{:g},{},{:.3f},{:.3f}\n", screen_d, rendering.render_distance_mm, accommodation_d,
+          "{:g},{:.1f},{:g},{},{:.3f},{:.3f},{},{:.3f},{:.3f}\n", screen_d, rendering.render_distance_mm,
+          accommodation_d,
           std::isfinite(sweep_eye.focus_mm) ? fmt::format("{:.1f}", sweep_eye.focus_mm) : std::string("inf"), r.psnr_db,
-          r.psnr_full_screen_db);
+          r.psnr_full_screen_db, comfortable.contains(accommodation_d) ? 1 : 0, flat_db, r.psnr_db - flat_db);
     }
   }
+  gain.y_ticks = map.y_ticks;
+  gain.lines = map.lines;
 
-  write_sweep(map, csv, csv_path, "sweep");
+  write_sweep(map, csv, csv_path, "sweep", with_depth ? &gain : nullptr);
 }
 
 // The focus sweep as a table (one row per accommodation and region) and a heatmap beside it (one
@@ -288,6 +362,7 @@ void run_simulate(const SimulateArgs& args) {
     if (!output.empty()) inputs.refuse_as_output(output);
   for (const std::string& table : {args.sweep, args.focus_sweep})
     if (!table.empty()) inputs.refuse_as_output(std::filesystem::path(table).replace_extension(".png").string());
+  if (!args.sweep.empty()) inputs.refuse_as_output(gain_heatmap_path(args.sweep).string());
   check_writable(args.output, "--output");
   check_writable(args.ideal, "--ideal");
   check_writable(args.sweep, "--sweep");
@@ -315,28 +390,15 @@ void run_simulate(const SimulateArgs& args) {
   const View& view = input.view(eye);
   const EyeMapping rendering = make_eye_mapping(profile, eye, view.aspect());
   const DepthGeometry geometry = depth_geometry(profile, rendering);
-  const auto eye_surface = [&](const std::shared_ptr<const StereoDisparity>& d) {
-    return d ? std::make_shared<const DisparitySurface>(eye == Eye::left ? d->left : d->right) : nullptr;
-  };
 
-  // The depth the composite follows (--depth): the source's own where it knows it (auto), else the
-  // stereo matcher's estimate; none leaves everything on the flat screen.
-  std::shared_ptr<const StereoDisparity> composite_depth;
-  std::string depth_used = "none";
-  if (depth_mode != DepthMode::off) {
-    if (depth_mode == DepthMode::automatic && input.known_depth) {
-      composite_depth = input.known_depth;
-      depth_used = "known";
-    } else {
-      composite_depth = estimate_still_disparity(input.pair);
-      if (composite_depth)
-        depth_used = "estimated";
-      else if (!args.json)
-        fmt::print(stderr,
-                   "nelf: depth: the stereo pair cannot be matched (too little texture); simulating the flat "
-                   "screen\n");
-    }
-  }
+  // The depth the composite follows; none leaves everything on the flat screen.
+  const std::shared_ptr<const StereoDisparity> composite_depth = composite_depth_of(depth_mode, input);
+  const std::string depth_used = !composite_depth                       ? "none"
+                                 : composite_depth == input.known_depth ? "known"
+                                                                        : "estimated";
+  if (depth_mode != DepthMode::off && !composite_depth && !args.json)
+    fmt::print(stderr,
+               "nelf: depth: the stereo pair cannot be matched (too little texture); simulating the flat screen\n");
   // What the retina is compared with (--reference): the real scene where the source knows it.
   const bool scene_reference = reference == "scene" || (reference == "auto" && input.known_depth);
   if (scene_reference && !input.known_depth)
@@ -345,12 +407,13 @@ void run_simulate(const SimulateArgs& args) {
         "--reference screen",
         2);
   const std::optional<SceneDepth> scene =
-      scene_reference ? std::optional<SceneDepth>(SceneDepth{eye_surface(input.known_depth), geometry}) : std::nullopt;
+      scene_reference ? std::optional<SceneDepth>(SceneDepth{eye_surface(eye, input.known_depth), geometry})
+                      : std::nullopt;
   const SceneDepth* scene_ptr = scene ? &*scene : nullptr;
   // A panel with a defect map shows its defects, compensated unless asked not to; the retina and the
   // PSNR are of what it shows.
   const PanelImages panel = panel_images(profile, eye, view, rendering, eye_model.pupil_mm,
-                                         !args.no_defect_compensation, eye_surface(composite_depth));
+                                         !args.no_defect_compensation, eye_surface(eye, composite_depth));
   const EyeSimulator simulator(device, rendering, view.image);
   const DefectMap* defects = profile.correction.defects.get();
   const Image& clean = panel.clean;
@@ -396,7 +459,8 @@ void run_simulate(const SimulateArgs& args) {
     }
   }
 
-  if (!args.sweep.empty()) run_sweep(args, profile, eye, view, eye_model, args.sweep);
+  if (!args.sweep.empty())
+    run_sweep(args, profile, eye, {input, still, depth_mode, composite_depth, scene_reference}, eye_model, args.sweep);
   if (focus) write_focus_sweep(*focus, args, profile, eye_model.pupil_mm, scene_reference, args.focus_sweep);
   try {
     write_image_file(result.retina, args.output, {true, 8});
@@ -540,7 +604,9 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "Print one JSON object: psnr_db, focus_mm (null = infinity), pupil_mm, ...");
   cmd->add_option("--sweep", args->sweep,
                   "Also tabulate PSNR over screen distance (0.25-4 D) x accommodation (0-4 D) into this CSV and draw "
-                  "a heatmap beside it (.png); uses 1.5 retinal samples per display pixel and 5x5 pupil samples");
+                  "a heatmap beside it (.png) with the zone of comfort; composites with --depth and compares with "
+                  "--reference as the single simulation does (a synthetic scene is filmed for each distance); uses "
+                  "1.5 retinal samples per display pixel and 5x5 pupil samples");
   cmd->callback([args] { run_simulate(*args); });
 }
 
