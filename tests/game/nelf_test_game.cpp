@@ -6,7 +6,7 @@
 //
 //   nelf-test-game [--toolkit glfw|sdl2] [--mode sbs|sbs-half|tab|tab-half|fp|quad-buffer]
 //                  [--fps N] [--size WxH] [--frames N] [--duration S] [--title T] [--log FILE]
-//                  [--reopen-after N] [--exit-status N]
+//                  [--reopen-after N] [--exit-status N] [--scene bars|planes]
 //
 // --size is one eye's size (default 1280x720); the window is sized from it and the mode (fp: the
 // frame-packed window of that eye size, 1280x720 → 1280x1470). The game follows its window's size
@@ -14,7 +14,9 @@
 // SIGINT/SIGTERM, with status 0; bad options end it with status 2. --log writes "frame,present_ns"
 // for every frame presented. --reopen-after N closes the window after N frames and opens a new
 // one, as games do for a splash screen or a new video mode; --exit-status N is the status it ends
-// with (after --frames or --duration), for the tests of `nelf run`.
+// with (after --frames or --duration), for the tests of `nelf run`. --scene planes draws, instead of
+// the flat bars, two textured planes in perspective with a depth buffer, as a 3D game does
+// (planes_scene.hpp), for the tests of the game's depth.
 // epoxy before the toolkits' headers, which would include GL/gl.h.
 #include <epoxy/gl.h>
 
@@ -37,6 +39,7 @@
 #include <vector>
 
 #include "core/frame_stamp.hpp"
+#include "game/planes_scene.hpp"
 
 namespace {
 
@@ -58,6 +61,7 @@ struct Options {
   std::string log;
   long reopen_after = 0;  // 0: never
   int exit_status = 0;
+  bool planes = false;  // --scene planes
 };
 
 class BadUsage : public std::runtime_error {
@@ -123,6 +127,10 @@ Options parse(int argc, char** argv) {
     } else if (a == "--duration") {
       o.duration_s = number(a, value());
       if (!(o.duration_s > 0)) throw BadUsage("--duration must be > 0 seconds");
+    } else if (a == "--scene") {
+      const std::string v = value();
+      if (v != "bars" && v != "planes") throw BadUsage("--scene must be bars or planes, got '" + v + "'");
+      o.planes = v == "planes";
     } else if (a == "--title") {
       o.title = value();
     } else if (a == "--log") {
@@ -139,7 +147,7 @@ Options parse(int argc, char** argv) {
       std::puts(
           "nelf-test-game [--toolkit glfw|sdl2] [--mode sbs|sbs-half|tab|tab-half|fp|quad-buffer] [--fps N]\n"
           "               [--size WxH] [--frames N] [--duration S] [--title T] [--log FILE]\n"
-          "               [--reopen-after N] [--exit-status N]");
+          "               [--reopen-after N] [--exit-status N] [--scene bars|planes]");
       std::exit(0);
     } else {
       throw BadUsage("unknown option '" + a + "' (--help lists them)");
@@ -211,21 +219,88 @@ void fill(int window_h, int x, int y, int w, int h, float r, float g, float b) {
 }
 
 // One eye: a background, bars at two depths moving with the frame (disparity of opposite signs in
-// the two eyes), and the stamp band on top.
-void draw_eye(const Rect& eye, int window_h, long frame, double fps, int eye_sign, const nelf::FrameStamp& stamp) {
-  fill(window_h, eye.x, eye.y, eye.w, eye.h, 0.16f, 0.18f, 0.24f);
-  const double t = frame / fps;
-  const int disparity = eye.w / 40;
-  const int x_near = static_cast<int>((0.5 + 0.35 * std::sin(t * 1.3)) * eye.w * 0.8);
-  const int x_far = static_cast<int>((0.5 + 0.35 * std::cos(t * 0.7)) * eye.w * 0.8);
-  fill(window_h, eye.x + x_far - eye_sign * disparity / 2, eye.y + eye.h / 4, eye.w / 10, eye.h / 2, 0.2f, 0.55f, 0.9f);
-  fill(window_h, eye.x + x_near + eye_sign * disparity, eye.y + eye.h / 3, eye.w / 8, eye.h / 3, 0.95f, 0.45f, 0.2f);
+// the two eyes), and the stamp band on top; only the stamp over a scene already drawn (`over_scene`).
+void draw_eye(const Rect& eye, int window_h, long frame, double fps, int eye_sign, const nelf::FrameStamp& stamp,
+              bool over_scene) {
+  if (!over_scene) {
+    fill(window_h, eye.x, eye.y, eye.w, eye.h, 0.16f, 0.18f, 0.24f);
+    const double t = frame / fps;
+    const int disparity = eye.w / 40;
+    const int x_near = static_cast<int>((0.5 + 0.35 * std::sin(t * 1.3)) * eye.w * 0.8);
+    const int x_far = static_cast<int>((0.5 + 0.35 * std::cos(t * 0.7)) * eye.w * 0.8);
+    fill(window_h, eye.x + x_far - eye_sign * disparity / 2, eye.y + eye.h / 4, eye.w / 10, eye.h / 2, 0.2f, 0.55f,
+         0.9f);
+    fill(window_h, eye.x + x_near + eye_sign * disparity, eye.y + eye.h / 3, eye.w / 8, eye.h / 3, 0.95f, 0.45f, 0.2f);
+  }
   const auto bits = nelf::stamp_bits(stamp);
   for (int i = 0; i < nelf::kStampBits; ++i) {
     const nelf::StampCell c = nelf::stamp_cell(i, eye.w, eye.h);
     const float v = bits[static_cast<std::size_t>(i)] ? 1.0f : 0.0f;
     fill(window_h, eye.x + c.x0, eye.y + c.y0, c.x1 - c.x0, c.y1 - c.y0, v, v, v);
   }
+}
+
+// A texture of coloured noise for the planes: texture is what a stereo match needs.
+GLuint make_noise_texture() {
+  constexpr int kSize = 128;
+  std::vector<std::uint8_t> texels(kSize * kSize * 3);
+  std::uint32_t state = 12345;
+  for (std::uint8_t& t : texels) {
+    state = state * 1664525u + 1013904223u;
+    t = static_cast<std::uint8_t>(40 + (state >> 24) % 200);
+  }
+  GLuint texture = 0;
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, kSize, kSize, 0, GL_RGB, GL_UNSIGNED_BYTE, texels.data());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  return texture;
+}
+
+void textured_quad(double x0, double y0, double x1, double y1, double z, double s0, double t0, double s1, double t1) {
+  glBegin(GL_QUADS);
+  glTexCoord2d(s0, t0);
+  glVertex3d(x0, y0, -z);
+  glTexCoord2d(s1, t0);
+  glVertex3d(x1, y0, -z);
+  glTexCoord2d(s1, t1);
+  glVertex3d(x1, y1, -z);
+  glTexCoord2d(s0, t1);
+  glVertex3d(x0, y1, -z);
+  glEnd();
+}
+
+// One eye of --scene planes (planes_scene.hpp): the camera `eye_sign` half the eye separation to
+// the right (+1) or left (−1), its frustum shifted so that both meet at the convergence distance.
+void draw_planes(const Rect& eye, int window_h, int eye_sign, GLuint texture) {
+  using namespace nelf::test_game;
+  glViewport(eye.x, window_h - eye.y - eye.h, eye.w, eye.h);
+  glScissor(eye.x, window_h - eye.y - eye.h, eye.w, eye.h);
+  glClearColor(0, 0, 0, 1);
+  glClearDepth(1);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  const double half_w = kNearClip * half_fov_tangent(), half_h = half_w * eye.h / eye.w;
+  const double camera_x = eye_sign * kEyeSeparation / 2, shift = -camera_x * kNearClip / kConvergence;
+  glMatrixMode(GL_PROJECTION);
+  glLoadIdentity();
+  glFrustum(-half_w + shift, half_w + shift, -half_h, half_h, kNearClip, kFarClip);
+  glMatrixMode(GL_MODELVIEW);
+  glLoadIdentity();
+  glTranslated(-camera_x, 0, 0);
+  glEnable(GL_TEXTURE_2D);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_REPLACE);
+  const double far_half = 1.5 * kFarPlane * half_fov_tangent();
+  textured_quad(-far_half, -far_half, far_half, far_half, kFarPlane, 0, 0, 1, 1);
+  textured_quad(kNearLeft, kNearBottom, kNearRight, kNearTop, kNearPlane, 0.5, 0.5, 1.0, 0.9);
+  glDisable(GL_TEXTURE_2D);
+  glDisable(GL_DEPTH_TEST);
 }
 
 std::int64_t now_ns() {
@@ -340,6 +415,7 @@ int run(const Options& o) {
   int w = 0, h = 0;
   window_size(o, w, h);
   std::unique_ptr<GameWindow> window;
+  GLuint texture = 0;
   const auto open_window = [&] {
     window.reset();  // the old one first: its toolkit is shut down and started again
     if (o.toolkit == Toolkit::glfw)
@@ -347,6 +423,7 @@ int run(const Options& o) {
     else
       window = std::make_unique<SdlGameWindow>(o, w, h);
     glEnable(GL_SCISSOR_TEST);
+    if (o.planes) texture = make_noise_texture();  // the new window's context has none
   };
   open_window();
   const auto period = static_cast<std::int64_t>(std::llround(1e9 / o.fps));
@@ -368,9 +445,11 @@ int run(const Options& o) {
     const nelf::FrameStamp stamp{static_cast<std::uint32_t>(frame), now_ns()};
     // Quad-buffer stereo: each eye over the whole window, into its own back buffer.
     if (o.mode == Mode::quad_buffer) glDrawBuffer(GL_BACK_LEFT);
-    draw_eye(left, h, frame, o.fps, -1, stamp);
+    if (o.planes) draw_planes(left, h, -1, texture);
+    draw_eye(left, h, frame, o.fps, -1, stamp, o.planes);
     if (o.mode == Mode::quad_buffer) glDrawBuffer(GL_BACK_RIGHT);
-    draw_eye(right, h, frame, o.fps, +1, stamp);
+    if (o.planes) draw_planes(right, h, +1, texture);
+    draw_eye(right, h, frame, o.fps, +1, stamp, o.planes);
     window->swap();
     if (log) std::fprintf(log.get(), "%ld,%lld\n", frame, static_cast<long long>(stamp.present_ns));
     deadline += period;
