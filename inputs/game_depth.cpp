@@ -169,24 +169,42 @@ std::shared_ptr<const StereoDisparity> GameDepthRelation::disparity(const GameEy
   gap_ = GameDepthGap::none;
   const auto [bx, by] = block;
   const int mw = w / bx, mh = h / by;
-  auto out = std::make_shared<StereoDisparity>();
+  std::shared_ptr<StereoDisparity> out = reusable_maps();
   out->origin = DisparityOrigin::game;
-  // A block's disparity is the mean of its pixels': the line of the mean depth value.
-  const double scale = 1.0 / bx, per_block = 1.0 / (bx * by);
+  // A block's disparity is the mean of its pixels': the line of the mean depth value, in the map's
+  // pixels (a block is bx eye pixels wide).
+  const float offset = static_cast<float>(relation_->offset / bx);
+  const float slope = static_cast<float>(relation_->slope / bx / (bx * by));
   for (int i = 0; i < 2; ++i) {
     ViewDisparity& map = i == 0 ? out->left : out->right;
     map.width = mw;
     map.height = mh;
     map.d.resize(static_cast<std::size_t>(mw) * mh);
-    for (int my = 0; my < mh; ++my)
+    for (int my = 0; my < mh; ++my) {
+      float* row = map.d.data() + static_cast<std::size_t>(my) * mw;
+      if (bx == 1 && by == 1) {
+        const float* depth = eyes.depth[i].first_row + my * eyes.depth[i].row_step;
+        for (int mx = 0; mx < mw; ++mx) row[mx] = offset + slope * depth[mx];
+        continue;
+      }
       for (int mx = 0; mx < mw; ++mx) {
-        double sum = 0;
+        float sum = 0;
         for (int y = my * by; y < (my + 1) * by; ++y)
           for (int x = mx * bx; x < (mx + 1) * bx; ++x) sum += depth_at(eyes.depth[i], x, y);
-        map.d[static_cast<std::size_t>(my) * mw + mx] = static_cast<float>(relation_->at(sum * per_block) * scale);
+        row[mx] = offset + slope * sum;
       }
+    }
   }
   return out;
+}
+
+std::shared_ptr<StereoDisparity> GameDepthRelation::reusable_maps() {
+  for (std::shared_ptr<StereoDisparity>& maps : handed_out_)
+    if (maps.use_count() == 1) return maps;
+  // A few in flight at once (the queue between the source and the compositor); more are not kept.
+  auto maps = std::make_shared<StereoDisparity>();
+  if (handed_out_.size() < 4) handed_out_.push_back(maps);
+  return maps;
 }
 
 }  // namespace nelf

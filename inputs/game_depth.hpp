@@ -69,6 +69,11 @@ class GameDepthRelation {
   void match_points(const GameEyes& eyes, float depth_range);
   void fit();
 
+  // Maps handed out before: one no frame holds any more is written again rather than allocated
+  // (a fresh 1280×720 pair costs more in page faults than in filling it).
+  std::shared_ptr<StereoDisparity> reusable_maps();
+  std::vector<std::shared_ptr<StereoDisparity>> handed_out_;
+
   std::vector<Sample> pool_;  // the last frames' matches, oldest overwritten first
   std::size_t next_ = 0;
   std::optional<DepthToDisparity> relation_;

@@ -18,6 +18,7 @@
 #include "core/printable.hpp"
 #include "core/unix_socket.hpp"
 #include "core/user_error.hpp"
+#include "inputs/game_depth.hpp"
 #include "inputs/glx_stereo_protocol.hpp"
 #include "inputs/glx_stereo_source.hpp"
 #include "inputs/source.hpp"
@@ -98,7 +99,7 @@ struct Unmap {
 class GlxStereoSource final : public Source {
  public:
   explicit GlxStereoSource(const SourceRequest& r)
-      : input_(r.input), spec_(parse_glx_stereo_spec(r.input)), swap_(r.swap_eyes) {
+      : input_(r.input), spec_(parse_glx_stereo_spec(r.input)), swap_(r.swap_eyes), quiet_(r.quiet) {
     const UniqueFd listener = listen_on_unix_socket(spec_.socket, input_);
     struct RemoveSocket {
       std::string path;
@@ -131,6 +132,11 @@ class GlxStereoSource final : public Source {
                        : MAP_FAILED;
     if (mapped == MAP_FAILED) throw UserError(fmt::format("{}: cannot map the game's frames", printable(input_)), 1);
     shared_ = std::unique_ptr<unsigned char, Unmap>(static_cast<unsigned char*>(mapped), Unmap{bytes});
+    if (r.known_depth) {
+      protocol::Message want;
+      want.type = protocol::MessageType::want_depth;
+      depth_ = ::send(link_.get(), &want, sizeof want, MSG_NOSIGNAL) == static_cast<ssize_t>(sizeof want);
+    }
     origin_ = std::chrono::steady_clock::now();
     description_ = fmt::format("{}: a quad-buffer OpenGL game, two {}x{} eyes{}, live", input_, width_, height_,
                                swap_ ? " swapped" : "");
@@ -198,6 +204,7 @@ class GlxStereoSource final : public Source {
     frame.bits = 8;
     frame.left = view(swap_ ? 1 : 0);
     frame.right = view(swap_ ? 0 : 1);
+    if (depth_ && head->depth == 1) frame.disparity = disparity(slot);
     std::atomic_thread_fence(std::memory_order_acquire);
     if (std::atomic_ref<std::uint64_t>(head->sequence).load(std::memory_order_relaxed) != before) return std::nullopt;
     frame.width = width_;
@@ -210,9 +217,50 @@ class GlxStereoSource final : public Source {
     return frame;
   }
 
+  // Both eyes' disparity from their depth buffers in `slot`; null (and said once) when the buffers
+  // cannot give it: the estimate from the views stands in then (`--depth auto`).
+  std::shared_ptr<const StereoDisparity> disparity(const unsigned char* slot) {
+    const auto w = static_cast<std::uint32_t>(width_), h = static_cast<std::uint32_t>(height_);
+    const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(w) * 4;
+    GameEyes eyes;
+    eyes.width = width_;
+    eyes.height = height_;
+    for (int i = 0; i < 2; ++i) {
+      const int from = swap_ ? 1 - i : i;
+      // GL's rows are bottom-up: the top row is the last one.
+      eyes.colour[i] = {slot + protocol::kSlotHeader + static_cast<std::size_t>(from) * protocol::eye_bytes(w, h) +
+                            (height_ - 1) * stride,
+                        -stride};
+      const auto* depth = reinterpret_cast<const float*>(slot + protocol::depth_offset(w, h, from));
+      eyes.depth[i] = {depth + static_cast<std::ptrdiff_t>(height_ - 1) * width_, -static_cast<std::ptrdiff_t>(width_)};
+    }
+    std::shared_ptr<const StereoDisparity> out = relation_.disparity(eyes, block_);
+    const GameDepthGap gap = relation_.gap();
+    if (!out && !quiet_ && gap != said_gap_) {
+      said_gap_ = gap;
+      fmt::print(stderr, "nelf: {}: {}; its depth is estimated from the views meanwhile\n", printable(input_),
+                 gap == GameDepthGap::empty_buffers
+                     ? "the game's depth buffers are empty (it draws without depth, or into framebuffers of its own)"
+                     : "too few points of the game's views match yet to relate its depth buffers to them");
+    }
+    if (out && !said_depth_ && !quiet_) {
+      said_depth_ = true;
+      const DepthToDisparity line = *relation_.relation();
+      fmt::print(stderr,
+                 "nelf: {}: depth from the game's depth buffers (disparity {:.2f} px + {:.2f} px x depth value)\n",
+                 printable(input_), line.offset, line.slope);
+    }
+    return out;
+  }
+
   std::string input_;
   GlxStereoSpec spec_;
   bool swap_ = false;
+  bool quiet_ = false;
+  bool depth_ = false;  // the interposer was asked for the depth buffers
+  GameDepthRelation relation_;
+  GameDepthGap said_gap_ = GameDepthGap::none;
+  bool said_depth_ = false;
   UniqueFd link_;
   std::unique_ptr<unsigned char, Unmap> shared_;
   int width_ = 0, height_ = 0;

@@ -6,7 +6,9 @@
 // The game's side connects to $NELF_GLX_STEREO_SOCKET at its first buffer swap and sends a hello:
 // stereo (it drew into GL_BACK_RIGHT, so the interposer keeps each eye's back buffer) with a memfd
 // of kSlots frame slots attached (SCM_RIGHTS), or mono (then it closes: nelf captures the window).
-// Then one frame message per swap, naming the slot just written. The slots are written in turn and
+// Then one frame message per swap, naming the slot just written. nelf may answer once with
+// want_depth (it composites with the game's depth, `--depth auto`): from then on each slot also
+// holds both eyes' depth buffers. The slots are written in turn and
 // guarded by a sequence number (odd while written), so that a reader that fell behind notices a slot
 // overwritten under it instead of showing a torn frame; the game never waits for nelf.
 #include <cstddef>
@@ -14,11 +16,11 @@
 
 namespace nelf::glx_stereo {
 
-inline constexpr std::uint32_t kMagic = 0x4e4c4631;  // "NLF1"
+inline constexpr std::uint32_t kMagic = 0x4e4c4632;  // "NLF2"
 inline constexpr int kSlots = 3;
 inline constexpr const char* kSocketVariable = "NELF_GLX_STEREO_SOCKET";
 
-enum class MessageType : std::uint32_t { hello = 1, frame = 2 };
+enum class MessageType : std::uint32_t { hello = 1, frame = 2, want_depth = 3 };
 
 struct Message {
   std::uint32_t magic = kMagic;
@@ -33,20 +35,27 @@ struct Message {
 static_assert(sizeof(Message) == 40);
 
 // The head of each slot; the left eye's RGBA rows follow at kSlotHeader, then the right eye's, each
-// width × height × 4 bytes, rows bottom-up (as glReadPixels gives them).
+// width × height × 4 bytes, then, when `depth` is 1, the left and the right eye's depth buffers as
+// floats (0..1) of width × height × 4 bytes each; rows bottom-up (as glReadPixels gives them).
 struct SlotHeader {
   std::uint64_t sequence;  // odd while the game writes the slot; atomic_ref'd on both sides
   std::uint64_t frame;
   std::int64_t swapped_ns;
+  std::uint32_t depth;  // 1: the depth buffers follow the colour
 };
 inline constexpr std::size_t kSlotHeader = 64;
 
 inline std::size_t eye_bytes(std::uint32_t width, std::uint32_t height) {
   return static_cast<std::size_t>(width) * height * 4;
 }
-// Slots start on page boundaries.
+// Where eye `i`'s depth buffer starts in a slot.
+inline std::size_t depth_offset(std::uint32_t width, std::uint32_t height, int i) {
+  return kSlotHeader + (2 + static_cast<std::size_t>(i)) * eye_bytes(width, height);
+}
+// Slots start on page boundaries, with room for the depth buffers (pages that are never written
+// cost no memory).
 inline std::size_t slot_stride(std::uint32_t width, std::uint32_t height) {
-  const std::size_t bytes = kSlotHeader + 2 * eye_bytes(width, height);
+  const std::size_t bytes = kSlotHeader + 4 * eye_bytes(width, height);
   return (bytes + 4095) / 4096 * 4096;
 }
 inline std::size_t shared_bytes(std::uint32_t width, std::uint32_t height) {

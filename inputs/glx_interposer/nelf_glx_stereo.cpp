@@ -2,9 +2,9 @@
 // for quad-buffer stereo what Mesa never offers: stereo visuals and FBConfigs, and a back buffer per
 // eye. Everything the game draws into GL_BACK_LEFT / GL_BACK_RIGHT goes into two framebuffer objects
 // of the window's size; at each swap both eyes are read into shared memory for nelf's `glx-stereo:`
-// source (inputs/glx_stereo_protocol.hpp), the left eye is copied into the window so that the game's
-// own window still shows its picture, and the real swap follows. A game that never draws into a
-// right buffer is left as it is (its window is captured instead).
+// source (inputs/glx_stereo_protocol.hpp), with their depth buffers when nelf asks for them, the left eye is copied
+// into the window so that the game's own window still shows its picture, and the real swap follows. A game that never
+// draws into a right buffer is left as it is (its window is captured instead).
 //
 // Games reach GLX and GL in three ways, all covered: by linking libGL (the symbols below win over
 // libGL's through LD_PRELOAD), through glXGetProcAddress(ARB) (GLFW, SDL2, libepoxy), and through
@@ -171,7 +171,19 @@ class NelfLink {
     send(message, -1);
   }
 
+  // Whether nelf asked for the depth buffers (it composites with the game's depth): read without
+  // waiting, once asked always.
+  bool depth_wanted() {
+    if (depth_wanted_ || fd_ < 0) return depth_wanted_;
+    protocol::Message message;
+    const ssize_t n = ::recv(fd_, &message, sizeof message, MSG_DONTWAIT);
+    depth_wanted_ = n == static_cast<ssize_t>(sizeof message) && message.magic == protocol::kMagic &&
+                    message.type == protocol::MessageType::want_depth;
+    return depth_wanted_;
+  }
+
   void close() {
+    depth_wanted_ = false;
     if (shared_) munmap(shared_, bytes_);
     shared_ = nullptr;
     if (fd_ >= 0) ::close(fd_);
@@ -205,6 +217,7 @@ class NelfLink {
   }
 
   int fd_ = -1;
+  bool depth_wanted_ = false;
   unsigned char* shared_ = nullptr;
   std::size_t bytes_ = 0;
   std::uint32_t width_ = 0, height_ = 0;
@@ -341,7 +354,8 @@ void activate(Eyes& e) {
   bind_read(e);
 }
 
-// Both eyes into the next shared slot, rows bottom-up as GL reads them.
+// Both eyes into the next shared slot, rows bottom-up as GL reads them, and their depth buffers
+// when nelf wants them.
 void send_eyes(Eyes& e, std::int64_t swapped_ns) {
   NELF_REAL_GL(glGetIntegerv);
   NELF_REAL_GL(glPixelStorei);
@@ -370,6 +384,14 @@ void send_eyes(Eyes& e, std::int64_t swapped_ns) {
     real_glBindFramebuffer(GL_READ_FRAMEBUFFER, e.fbo[i]);
     real_glReadPixels(0, 0, e.width, e.height, GL_RGBA, GL_UNSIGNED_BYTE, slot + protocol::kSlotHeader + i * eye_bytes);
   }
+  const bool depth = e.link.depth_wanted();
+  for (int i = 0; depth && i < 2; ++i) {
+    real_glBindFramebuffer(GL_READ_FRAMEBUFFER, e.fbo[i]);
+    real_glReadPixels(
+        0, 0, e.width, e.height, GL_DEPTH_COMPONENT, GL_FLOAT,
+        slot + protocol::depth_offset(static_cast<std::uint32_t>(e.width), static_cast<std::uint32_t>(e.height), i));
+  }
+  reinterpret_cast<protocol::SlotHeader*>(slot)->depth = depth ? 1 : 0;
   real_glBindBuffer(GL_PIXEL_PACK_BUFFER, static_cast<GLuint>(pack_buffer));
   real_glPixelStorei(GL_PACK_ALIGNMENT, alignment);
   real_glPixelStorei(GL_PACK_ROW_LENGTH, row_length);

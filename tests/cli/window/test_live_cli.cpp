@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <regex>
 #include <string>
 #include <thread>
 
+#include "game/planes_scene.hpp"
 #include "support/test_game.hpp"
 #include "support/test_support.hpp"
 #include "support/xvfb.hpp"
@@ -118,6 +120,37 @@ TEST_F(LiveCliTest, RunGivesAQuadBufferGameBothEyes) {
                                " --mode sbs --size 320x180 --fps 30 --duration 3");
   ASSERT_EQ(window.status, 0) << window.err;
   EXPECT_NE(window.err.find("layout sbs (aspect)"), std::string::npos) << window.err;
+}
+
+TEST_F(LiveCliTest, RunGivesTheGamesDepthToTheCompositor) {
+  // `--depth auto` under nelf run: the eyes' depth buffers come from the interposer and are related
+  // to the views. The relation nelf finds is the one the test game's projection and cameras make:
+  // glFrustum's depth value is a − b/z (a = f/(f−n), b = f·n/(f−n)) and the disparity F·e·(1/z − 1/c),
+  // so disparity = F·e·(a/b − 1/c) − (F·e/b) · depth value (planes_scene.hpp).
+  const auto r = run_nelf("run --depth auto --output offscreen -- " + shell_quote(NELF_TEST_GAME) +
+                          " --mode quad-buffer --scene planes --size 320x180 --fps 30 --duration 4");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(
+      r.err, m,
+      std::regex(
+          "depth from the game's depth buffers \\(disparity (-?[0-9.]+) px \\+ (-?[0-9.]+) px x depth value\\)")))
+      << r.err;
+  using namespace test_game;
+  const double a = kFarClip / (kFarClip - kNearClip), b = kFarClip * kNearClip / (kFarClip - kNearClip);
+  const double fe = 0.5 * 320 / half_fov_tangent() * kEyeSeparation;
+  const double offset = fe * (a / b - 1 / kConvergence), slope = -fe / b;
+  EXPECT_NEAR(std::stod(m[1]), offset, 0.03 * std::abs(offset)) << r.err;
+  EXPECT_NEAR(std::stod(m[2]), slope, 0.03 * std::abs(slope)) << r.err;
+  // A game that draws without depth (the flat bars): said once, and its depth estimated instead.
+  const auto flat = run_nelf("run --depth auto --output offscreen -- " + shell_quote(NELF_TEST_GAME) +
+                             " --mode quad-buffer --size 320x180 --fps 30 --duration 2");
+  ASSERT_EQ(flat.status, 0) << flat.err;
+  const std::string said =
+      "the game's depth buffers are empty (it draws without depth, or into framebuffers of its "
+      "own); its depth is estimated from the views meanwhile";
+  ASSERT_NE(flat.err.find(said), std::string::npos) << flat.err;
+  EXPECT_EQ(flat.err.find(said, flat.err.find(said) + 1), std::string::npos) << flat.err;  // once
 }
 
 TEST_F(LiveCliTest, FfmpegCaptureDevicesAreInputsToo) {

@@ -5,11 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "core/frame_stamp.hpp"
+#include "game/planes_scene.hpp"
 #include "inputs/glx_stereo_protocol.hpp"
 #include "inputs/glx_stereo_source.hpp"
 #include "inputs/source_drivers.hpp"
@@ -102,6 +105,58 @@ TEST_F(GlxStereoSourceTest, SwapEyesSwapsTheGamesEyes) {
   ASSERT_GE(first, 0);
   ASSERT_GE(second, 0);
   EXPECT_GT(first, second);
+}
+
+// Where the left camera of the test game's planes scene shows the point (x, 0, z): the view's column.
+double planes_left_column(int width, double x, double z) {
+  using namespace test_game;
+  const double camera_x = -kEyeSeparation / 2;
+  const double ndc = ((x - camera_x) / z + camera_x / kConvergence) / half_fov_tangent();
+  return (ndc + 1) / 2 * width;
+}
+
+TEST_F(GlxStereoSourceTest, TheGamesDepthBuffersGiveTheDisparityItsCamerasMake) {
+  // `--depth auto`: the source asks the interposer for the depth buffers and relates them to the
+  // views; the disparity of each plane is what the game's two cameras give it (planes_scene.hpp).
+  for (const char* toolkit : {"glfw", "sdl2"}) {
+    SCOPED_TRACE(toolkit);
+    test::TestGame game(
+        {"--toolkit", toolkit, "--mode", "quad-buffer", "--scene", "planes", "--size", "320x180", "--fps", "30"},
+        interposed());
+    SourceRequest request = quiet_request("glx-stereo:wait=20,socket=" + socket());
+    request.known_depth = true;
+    auto source = open_source(request);
+    std::shared_ptr<const StereoDisparity> d;
+    for (int i = 0; i < 30 && !d; ++i) {
+      const std::optional<StereoVideoFrame> f = source->next();
+      ASSERT_TRUE(f);
+      d = f->disparity;
+    }
+    ASSERT_TRUE(d) << "no frame with the game's depth in 30";
+    EXPECT_EQ(d->origin, DisparityOrigin::game);
+    ASSERT_EQ(d->left.width, 320);
+    ASSERT_EQ(d->left.height, 180);
+    using namespace test_game;
+    const double near_expected = planes_disparity(320, kNearPlane), far_expected = planes_disparity(320, kFarPlane);
+    const int row = 90;  // the view's middle row: both planes
+    const int near_x = static_cast<int>(planes_left_column(320, (kNearLeft + kNearRight) / 2, kNearPlane));
+    const int far_x = static_cast<int>(planes_left_column(320, 0.6, kFarPlane));
+    EXPECT_NEAR(d->left.d[row * 320 + near_x], near_expected, 0.5);
+    EXPECT_NEAR(d->left.d[row * 320 + far_x], far_expected, 0.5);
+    // The right view: the same plane's pixel is d to the left of the left view's.
+    EXPECT_NEAR(d->right.d[row * 320 + near_x - static_cast<int>(std::lround(near_expected))], near_expected, 0.5);
+    EXPECT_NEAR(d->right.d[row * 320 + far_x], far_expected, 0.5);
+  }
+}
+
+TEST_F(GlxStereoSourceTest, WithoutDepthAskedForTheFramesCarryNone) {
+  test::TestGame game({"--mode", "quad-buffer", "--scene", "planes", "--size", "320x180", "--fps", "30"}, interposed());
+  auto source = open_source(quiet_request("glx-stereo:wait=20,socket=" + socket()));
+  for (int i = 0; i < 5; ++i) {
+    const std::optional<StereoVideoFrame> f = source->next();
+    ASSERT_TRUE(f);
+    EXPECT_FALSE(f->disparity);
+  }
 }
 
 TEST_F(GlxStereoSourceTest, DlsymRtldNextStillMeansAfterTheCaller) {
