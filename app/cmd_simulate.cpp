@@ -24,6 +24,8 @@
 #include "compositor/reference.hpp"
 #include "core/printable.hpp"
 #include "hmz_output/image_sink.hpp"
+#include "inputs/glx_stereo_source.hpp"
+#include "inputs/source_drivers.hpp"
 #include "inputs/stereo_matcher.hpp"
 #include "inputs/still_source.hpp"
 #include "inputs/synthetic_source.hpp"
@@ -152,7 +154,46 @@ struct SimulatedInput {
   const View& view(Eye eye) const { return eye == Eye::left ? pair.left : pair.right; }
 };
 
+// An RGBA8 view of a frame as simulate's float image.
+View frame_view(const std::vector<std::uint8_t>& rgba, int width, int height, double aspect) {
+  View view;
+  view.image = Image(width, height);
+  float* out = view.image.data();
+  for (std::size_t i = 0; i < rgba.size(); ++i) out[i] = rgba[i] / 255.0f;
+  view.display_aspect = aspect;
+  return view;
+}
+
+// A quad-buffer game's frame (glx-stereo:, the game started with nelf's interposer), as it plays:
+// `want_depth`, the first frame whose depth buffers gave its disparity (the relation to the views
+// takes a frame or a few), within 120 frames; otherwise, or failing that, the frame at hand.
+SimulatedInput load_game_frame(const SimulateArgs& args, bool want_depth) {
+  SourceRequest request;
+  request.input = args.input;
+  request.swap_eyes = args.swap_eyes;
+  request.known_depth = want_depth;
+  request.quiet = args.json;
+  const std::unique_ptr<Source> source = open_source(request);
+  std::optional<StereoVideoFrame> frame;
+  for (int i = 0; i < 120; ++i) {
+    std::optional<StereoVideoFrame> next = source->next();
+    if (!next) break;
+    frame = std::move(next);
+    if (!want_depth || frame->disparity) break;
+  }
+  if (!frame) throw UserError(fmt::format("{}: the game ended before it showed a frame", printable(args.input)));
+  if (frame->bits != 8 || frame->block != std::array<int, 2>{1, 1})
+    throw UserError(fmt::format("{}: the game's frame came in a form simulate does not read", printable(args.input)));
+  SimulatedInput in;
+  in.pair.left = frame_view(frame->left, frame->width, frame->height, frame->aspect);
+  in.pair.right = frame_view(frame->right, frame->width, frame->height, frame->aspect);
+  in.known_depth = frame->disparity;
+  return in;
+}
+
 SimulatedInput load_simulated_input(const SimulateArgs& args, const StillOptions& still, const Profile& profile) {
+  // Its depth always, as a synthetic scene's: the real scene to compare with, even on the flat screen.
+  if (is_glx_stereo_spec(args.input)) return load_game_frame(args, true);
   SimulatedInput in;
   if (is_synthetic_spec(args.input)) {
     // The built-in clip's first frame, filmed for this display's emulated screen so that the depth
@@ -393,9 +434,10 @@ void run_simulate(const SimulateArgs& args) {
 
   // The depth the composite follows; none leaves everything on the flat screen.
   const std::shared_ptr<const StereoDisparity> composite_depth = composite_depth_of(depth_mode, input);
-  const std::string depth_used = !composite_depth                       ? "none"
-                                 : composite_depth == input.known_depth ? "known"
-                                                                        : "estimated";
+  const std::string depth_used = !composite_depth ? "none"
+                                 : composite_depth == input.known_depth
+                                     ? (input.known_depth->origin == DisparityOrigin::game ? "game" : "known")
+                                     : "estimated";
   if (depth_mode != DepthMode::off && !composite_depth && !args.json)
     fmt::print(stderr,
                "nelf: depth: the stereo pair cannot be matched (too little texture); simulating the flat screen\n");
@@ -524,7 +566,7 @@ void run_simulate(const SimulateArgs& args) {
     j["evaluated_fraction"] = result.evaluated_fraction;
     j["retina_size"] = {result.retina.width(), result.retina.height()};
     j["depth"] = depth_mode_name(depth_mode);
-    j["depth_used"] = depth_used;  // none, known or estimated
+    j["depth_used"] = depth_used;  // none, known, game or estimated
     j["reference"] = scene_reference ? "scene" : "screen";
     if (!region_results.empty()) {
       j["regions"] = nlohmann::json::array();

@@ -11,7 +11,11 @@
 #include <string>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "game/planes_scene.hpp"
+#include "inputs/glx_stereo_protocol.hpp"
+#include "inputs/glx_stereo_source.hpp"
 #include "support/test_game.hpp"
 #include "support/test_support.hpp"
 #include "support/xvfb.hpp"
@@ -151,6 +155,32 @@ TEST_F(LiveCliTest, RunGivesTheGamesDepthToTheCompositor) {
       "own); its depth is estimated from the views meanwhile";
   ASSERT_NE(flat.err.find(said), std::string::npos) << flat.err;
   EXPECT_EQ(flat.err.find(said, flat.err.find(said) + 1), std::string::npos) << flat.err;  // once
+}
+
+TEST_F(LiveCliTest, SimulateShowsWhatTheEyeSeesOfAGamesFrameWithItsDepth) {
+  // simulate takes a quad-buffer game's frame (the game started with the interposer by hand) and,
+  // with --depth auto, composites it with the game's own depth, against the scene at that depth.
+  const std::string socket = (dir_.path() / "game.sock").string();
+  test::TestGame game(
+      {"--mode", "quad-buffer", "--scene", "planes", "--size", "320x180", "--fps", "30"},
+      {"LD_PRELOAD=" + glx_stereo_library_path(), std::string(glx_stereo::kSocketVariable) + "=" + socket});
+  const auto json_of = [&](const std::string& depth) {
+    const auto r = run_nelf("simulate " + shell_quote("glx-stereo:wait=20,socket=" + socket) + " --depth " + depth +
+                            " --json -o " + shell_quote((dir_.path() / (depth + ".png")).string()));
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(r.out);
+  };
+  const nlohmann::json with_depth = json_of("auto");
+  EXPECT_EQ(with_depth["depth_used"], "game") << with_depth.dump();
+  const nlohmann::json flat = json_of("off");
+  EXPECT_EQ(flat["depth_used"], "none") << flat.dump();
+  // Both against the same real scene (the game's depth, asked for whatever --depth says), and the
+  // composite follows that depth only with auto: the retinas differ.
+  EXPECT_EQ(with_depth["reference"], "scene") << with_depth.dump();
+  EXPECT_EQ(flat["reference"], "scene") << flat.dump();
+  EXPECT_GT(std::abs(with_depth["psnr_db"].get<double>() - flat["psnr_db"].get<double>()), 0.05)
+      << with_depth.dump() << "\n"
+      << flat.dump();
 }
 
 TEST_F(LiveCliTest, FfmpegCaptureDevicesAreInputsToo) {
