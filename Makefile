@@ -5,7 +5,7 @@ ASAN_BUILD ?= build-asan
 FUZZ_BUILD ?= build-fuzz
 FUZZ_TIME  ?= 60
 # `make test` runs each fuzz target this many seconds (CI's bounded run; docs/fuzzing.md).
-CI_FUZZ_TIME ?= 15
+CI_FUZZ_TIME ?= 10
 JOBS       ?= $(shell nproc)
 CMAKE_ARGS ?=
 
