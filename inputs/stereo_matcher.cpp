@@ -177,8 +177,8 @@ void temper(cv::Mat& d, const cv::Mat& gray, const cv::Mat& previous_d, const cv
 // interpolates the four nearest matched samples, each weighted by how close its gray level in
 // `low` is to the pixel's in `guide`, so that depth edges follow the view's edges. Disparities are
 // rescaled to the output's pixels.
-ViewDisparity upsample(const cv::Mat& d, const cv::Mat& low, const cv::Mat& guide) {
-  ViewDisparity out;
+// Into `out`, whose storage is reused when it has the size already.
+void upsample(const cv::Mat& d, const cv::Mat& low, const cv::Mat& guide, ViewDisparity& out) {
   out.width = guide.cols;
   out.height = guide.rows;
   out.d.resize(static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height));
@@ -231,7 +231,6 @@ ViewDisparity upsample(const cv::Mat& d, const cv::Mat& low, const cv::Mat& guid
       }
     }
   });
-  return out;
 }
 
 struct Range {
@@ -244,6 +243,16 @@ struct StereoMatcher::State {
   cv::Ptr<cv::StereoBM> bm = cv::StereoBM::create(16, 9);
   // The previous frame at the working resolution: views and cross-checked, tempered maps.
   cv::Mat left_gray, right_gray, left_d, right_d;
+  // Maps handed out before, written again once no frame holds them: a fresh pair of 960×540 maps
+  // cost more in zero-filling and page faults than the upsampling that fills them.
+  std::vector<std::shared_ptr<StereoDisparity>> handed_out;
+  std::shared_ptr<StereoDisparity> reusable_maps() {
+    for (std::shared_ptr<StereoDisparity>& maps : handed_out)
+      if (maps.use_count() == 1) return maps;
+    auto maps = std::make_shared<StereoDisparity>();
+    if (handed_out.size() < 4) handed_out.push_back(maps);  // a few in flight at once; more are not kept
+    return maps;
+  }
 };
 
 StereoMatcher::StereoMatcher(StereoMatcherSettings settings) : settings_(settings), state_(std::make_unique<State>()) {
@@ -349,10 +358,10 @@ std::shared_ptr<const StereoDisparity> StereoMatcher::estimate(const StereoVideo
   s.left_d = left_d;
   s.right_d = right_d;
 
-  auto result = std::make_shared<StereoDisparity>();
+  std::shared_ptr<StereoDisparity> result = s.reusable_maps();
   result->origin = DisparityOrigin::estimated;
-  result->left = upsample(left_d, left_gray, left_guide);
-  result->right = upsample(right_d, right_gray, right_guide);
+  upsample(left_d, left_gray, left_guide, result->left);
+  upsample(right_d, right_gray, right_guide, result->right);
   return result;
 }
 
