@@ -77,8 +77,10 @@ Vec2 DisparitySurface::hit(Vec2 flat_uv, Vec2 gain) const {
   const double front = front_, back = back_;
   if (!(front > back) || meets(front)) return along(front);
   double hit = back, before = front;
-  for (int i = 1; i <= depth_search_steps; ++i) {
-    const double d = front - (front - back) * i / depth_search_steps;
+  const double extent = (front - back) * std::max(std::abs(gain.x) * width_, std::abs(gain.y) * height_);
+  const int steps = depth_search_steps_for(extent);
+  for (int i = 1; i <= steps; ++i) {
+    const double d = front - (front - back) * i / steps;
     if (meets(d)) {
       hit = d;
       break;

@@ -14,6 +14,7 @@
 // v + p δ/e, where δ is the disparity of the surface there: the view seen from a pupil point p is
 // the view from the centre shifted by p/e of its disparity (p = ±e is the other eye's view). The
 // front-most δ with δ = disparity(v + p δ/e) is where the ray meets the surface.
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -59,8 +60,9 @@ class DisparitySurface {
 
   // Where on the screen (uv) a ray shows the surface: the ray meets the flat screen at `flat_uv` and
   // shifts by `gain` (uv) per unit of δ / W (pupil_gain of its pupil-plane crossing). The front-most
-  // crossing, found by `depth_search_steps` steps from the front to the back and a bisection of the
-  // step that crosses. A surface of one value v gives flat_uv + gain · v exactly (0: flat_uv).
+  // crossing, found by steps from the front to the back (depth_search_steps_for the texels the ray
+  // crosses) and a bisection of the step that crosses. A surface of one value v gives
+  // flat_uv + gain · v exactly (0: flat_uv).
   Vec2 hit(Vec2 flat_uv, Vec2 gain) const;
 
  private:
@@ -73,6 +75,15 @@ class DisparitySurface {
 // Steps of the search from front to back, and bisections of the crossing step (the shader's too).
 inline constexpr int depth_search_steps = 24;
 inline constexpr int depth_search_bisections = 6;
+
+// The steps a ray takes that crosses `extent_texels` texels of the map between the front and the
+// back of the range: two a texel, so that no texel is stepped over, and at most depth_search_steps.
+// A ray moves a few texels at most (its pupil-plane crossing is within half the eye box), so most
+// take far fewer than 24; the shader computes the same in float.
+inline int depth_search_steps_for(double extent_texels) {
+  const double steps = std::ceil(2.0 * extent_texels);
+  return steps >= depth_search_steps ? depth_search_steps : steps <= 2.0 ? 2 : static_cast<int>(steps);
+}
 
 // The uv shift per unit of δ / W of a ray crossing the pupil plane at `pupil_mm`: (p_x / e, −p_y W / (e H)).
 Vec2 pupil_gain(const DepthGeometry& g, Vec2 pupil_mm);

@@ -46,8 +46,14 @@ vec2 surface_uv(vec2 flat_uv, vec2 gain) {
   const float back = u_disparity_range.x, front = u_disparity_range.y;
   if (!(front > back) || surface_disparity(flat_uv + gain * front) >= front) return flat_uv + gain * front;
   float hit = back, before = front;
-  for (int i = 1; i <= depth_search_steps; ++i) {
-    const float d = front - (front - back) * float(i) / float(depth_search_steps);
+  // optics/depth.hpp: depth_search_steps_for the texels the ray crosses.
+  const vec2 size = vec2(textureSize(u_disparity, 0));
+  const float extent = (front - back) * max(abs(gain.x) * size.x, abs(gain.y) * size.y);
+  const float wanted = ceil(2.0 * extent);
+  const int steps = wanted >= float(depth_search_steps) ? depth_search_steps : wanted <= 2.0 ? 2 : int(wanted);
+  for (int i = 1; i <= depth_search_steps; ++i) {  // a constant bound (llvmpipe), left at `steps`
+    if (i > steps) break;
+    const float d = front - (front - back) * float(i) / float(steps);
     if (surface_disparity(flat_uv + gain * d) >= d) {
       hit = d;
       break;
