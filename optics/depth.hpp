@@ -74,7 +74,7 @@ class DisparitySurface {
 
 // Steps of the search from front to back, and bisections of the crossing step (the shader's too).
 inline constexpr int depth_search_steps = 24;
-inline constexpr int depth_search_bisections = 6;
+inline constexpr int depth_search_bisections = 3;
 
 // The steps a ray takes that crosses `extent_texels` texels of the map between the front and the
 // back of the range: two a texel, so that no texel is stepped over, and at most depth_search_steps.

@@ -33,7 +33,7 @@ layout(location = 1) uniform vec2 u_parallax_gain;  // uv shift per mm of pupil 
 layout(location = 2) uniform vec2 u_disparity_range;  // back (smallest), front (largest) δ / W
 layout(location = 3) uniform float u_pupil_per_lens;  // d_e / d_l: chief ray's pupil crossing = c − (s − c) · this
 const int depth_search_steps = 24;                   // optics/depth.hpp: depth_search_steps
-const int depth_search_bisections = 6;               // and depth_search_bisections
+const int depth_search_bisections = 3;               // and depth_search_bisections
 
 float surface_disparity(vec2 uv) {
   const ivec2 size = textureSize(u_disparity, 0);
