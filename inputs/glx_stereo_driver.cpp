@@ -236,8 +236,10 @@ class GlxStereoSource final : public Source {
     }
     std::shared_ptr<const StereoDisparity> out = relation_.disparity(eyes, block_);
     const GameDepthGap gap = relation_.gap();
-    if (!out && !quiet_ && gap != said_gap_) {
-      said_gap_ = gap;
+    // Each reason once, however the frames alternate between them.
+    bool& said = gap == GameDepthGap::empty_buffers ? said_empty_ : said_too_few_;
+    if (!out && !quiet_ && !said) {
+      said = true;
       fmt::print(stderr, "nelf: {}: {}; its depth is estimated from the views meanwhile\n", printable(input_),
                  gap == GameDepthGap::empty_buffers
                      ? "the game's depth buffers are empty (it draws without depth, or into framebuffers of its own)"
@@ -259,7 +261,7 @@ class GlxStereoSource final : public Source {
   bool quiet_ = false;
   bool depth_ = false;  // the interposer was asked for the depth buffers
   GameDepthRelation relation_;
-  GameDepthGap said_gap_ = GameDepthGap::none;
+  bool said_empty_ = false, said_too_few_ = false;
   bool said_depth_ = false;
   UniqueFd link_;
   std::unique_ptr<unsigned char, Unmap> shared_;
