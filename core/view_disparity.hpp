@@ -1,4 +1,5 @@
 #pragma once
+#include <memory>
 #include <vector>
 
 namespace nelf {
@@ -21,6 +22,25 @@ enum class DisparityOrigin { known, game, estimated };
 struct StereoDisparity {
   ViewDisparity left, right;
   DisparityOrigin origin = DisparityOrigin::estimated;
+};
+
+// The maps a depth source hands out with its frames, written again once no frame holds them: a
+// fresh pair of full-size float maps costs more in zero-filling and page faults than the work that
+// fills them. A few are kept (the frames queued between a source and the compositor); when all are
+// held, a new pair is made and not kept. For one source, used from its thread.
+class ReusableDisparityMaps {
+ public:
+  std::shared_ptr<StereoDisparity> next() {
+    for (std::shared_ptr<StereoDisparity>& maps : handed_out_)
+      if (maps.use_count() == 1) return maps;  // only this pool holds it: no frame can any more
+    auto maps = std::make_shared<StereoDisparity>();
+    if (handed_out_.size() < kKept) handed_out_.push_back(maps);
+    return maps;
+  }
+
+ private:
+  static constexpr std::size_t kKept = 4;
+  std::vector<std::shared_ptr<StereoDisparity>> handed_out_;
 };
 
 }  // namespace nelf

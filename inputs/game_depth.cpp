@@ -148,7 +148,8 @@ void GameDepthRelation::fit() {
 std::shared_ptr<const StereoDisparity> GameDepthRelation::disparity(const GameEyes& eyes, std::array<int, 2> block) {
   const int w = eyes.width, h = eyes.height;
   ++frame_;
-  // Empty buffers: a game that renders into framebuffers of its own and copies only the colour.
+  // Empty buffers: a game that draws without depth, or into framebuffers of its own and copies only
+  // the colour to the window.
   float lo = std::numeric_limits<float>::infinity(), hi = -lo;
   for (const GameEyeDepth& eye : eyes.depth)
     for (int y = 0; y < h; y += std::max(1, h / 64))
@@ -169,7 +170,7 @@ std::shared_ptr<const StereoDisparity> GameDepthRelation::disparity(const GameEy
   gap_ = GameDepthGap::none;
   const auto [bx, by] = block;
   const int mw = w / bx, mh = h / by;
-  std::shared_ptr<StereoDisparity> out = reusable_maps();
+  std::shared_ptr<StereoDisparity> out = maps_.next();
   out->origin = DisparityOrigin::game;
   // A block's disparity is the mean of its pixels': the line of the mean depth value, in the map's
   // pixels (a block is bx eye pixels wide).
@@ -196,15 +197,6 @@ std::shared_ptr<const StereoDisparity> GameDepthRelation::disparity(const GameEy
     }
   }
   return out;
-}
-
-std::shared_ptr<StereoDisparity> GameDepthRelation::reusable_maps() {
-  for (std::shared_ptr<StereoDisparity>& maps : handed_out_)
-    if (maps.use_count() == 1) return maps;
-  // A few in flight at once (the queue between the source and the compositor); more are not kept.
-  auto maps = std::make_shared<StereoDisparity>();
-  if (handed_out_.size() < 4) handed_out_.push_back(maps);
-  return maps;
 }
 
 }  // namespace nelf

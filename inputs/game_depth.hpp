@@ -47,7 +47,7 @@ struct DepthToDisparity {
 // Why a frame has no disparity from its depth buffers.
 enum class GameDepthGap {
   none,
-  empty_buffers,   // every depth value the same: the game draws elsewhere (its own framebuffers)
+  empty_buffers,   // every depth value the same: the game draws without depth, or into framebuffers of its own
   too_few_matches  // not yet enough matched points (flat, dark or untextured frames) to fit
 };
 
@@ -69,10 +69,7 @@ class GameDepthRelation {
   void match_points(const GameEyes& eyes, float depth_range);
   void fit();
 
-  // Maps handed out before: one no frame holds any more is written again rather than allocated
-  // (a fresh 1280×720 pair costs more in page faults than in filling it).
-  std::shared_ptr<StereoDisparity> reusable_maps();
-  std::vector<std::shared_ptr<StereoDisparity>> handed_out_;
+  ReusableDisparityMaps maps_;  // a fresh 1280×720 pair cost more in page faults than in filling it
 
   std::vector<Sample> pool_;  // the last frames' matches, oldest overwritten first
   std::size_t next_ = 0;

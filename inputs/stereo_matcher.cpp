@@ -243,16 +243,8 @@ struct StereoMatcher::State {
   cv::Ptr<cv::StereoBM> bm = cv::StereoBM::create(16, 9);
   // The previous frame at the working resolution: views and cross-checked, tempered maps.
   cv::Mat left_gray, right_gray, left_d, right_d;
-  // Maps handed out before, written again once no frame holds them: a fresh pair of 960×540 maps
-  // cost more in zero-filling and page faults than the upsampling that fills them.
-  std::vector<std::shared_ptr<StereoDisparity>> handed_out;
-  std::shared_ptr<StereoDisparity> reusable_maps() {
-    for (std::shared_ptr<StereoDisparity>& maps : handed_out)
-      if (maps.use_count() == 1) return maps;
-    auto maps = std::make_shared<StereoDisparity>();
-    if (handed_out.size() < 4) handed_out.push_back(maps);  // a few in flight at once; more are not kept
-    return maps;
-  }
+  // The 960×540 maps handed out, written again once no frame holds them.
+  ReusableDisparityMaps maps;
 };
 
 StereoMatcher::StereoMatcher(StereoMatcherSettings settings) : settings_(settings), state_(std::make_unique<State>()) {
@@ -358,7 +350,7 @@ std::shared_ptr<const StereoDisparity> StereoMatcher::estimate(const StereoVideo
   s.left_d = left_d;
   s.right_d = right_d;
 
-  std::shared_ptr<StereoDisparity> result = s.reusable_maps();
+  std::shared_ptr<StereoDisparity> result = s.maps.next();
   result->origin = DisparityOrigin::estimated;
   upsample(left_d, left_gray, left_guide, result->left);
   upsample(right_d, right_gray, right_guide, result->right);
