@@ -48,7 +48,8 @@ ProbeResult probe(const ProbeOptions& options) {
   // A live input has no file to describe: play and convert print what they read of it.
   SourceRequest request;
   request.input = options.input;
-  if (const std::string driver(source_driver_for(request).name); driver == "x11" || driver == "device")
+  if (const std::string driver(source_driver_for(request).name);
+      driver == "x11" || driver == "device" || driver == "pipewire" || driver == "glx-stereo")
     throw UserError(fmt::format("{}: probe describes media files; a live input is described by play and convert",
                                 printable(options.input)),
                     2);

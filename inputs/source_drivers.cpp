@@ -10,6 +10,8 @@ bool accepts_synthetic(const SourceRequest& request);
 std::unique_ptr<Source> open_synthetic(const SourceRequest& request);
 bool accepts_x11(const SourceRequest& request);
 std::unique_ptr<Source> open_x11(const SourceRequest& request);
+bool accepts_pipewire(const SourceRequest& request);
+std::unique_ptr<Source> open_pipewire(const SourceRequest& request);
 bool accepts_glx_stereo(const SourceRequest& request);
 std::unique_ptr<Source> open_glx_stereo(const SourceRequest& request);
 bool accepts_device(const SourceRequest& request);
@@ -27,6 +29,8 @@ constexpr SourceDriver kDrivers[] = {
      drivers::accepts_synthetic, drivers::open_synthetic},
     {"x11", "x11:[display=:N,fps=N,wait=S,][window=TITLE|window-id=0x…]: a live X11 window (or the screen)",
      drivers::accepts_x11, drivers::open_x11},
+    {"pipewire", "pipewire:node=ID|NAME[,fps=N,wait=S]: a PipeWire video node (gamescope, a compositor's screen cast)",
+     drivers::accepts_pipewire, drivers::open_pipewire},
     {"glx-stereo",
      "glx-stereo:[wait=S,]socket=PATH: a quad-buffer OpenGL game's two eyes, from nelf's interposer in the game "
      "(nelf run starts it so)",

@@ -15,6 +15,8 @@
 #include <string_view>
 #include <vector>
 
+#include "inputs/live_capture.hpp"
+
 namespace nelf {
 
 // What `x11:[display=:N,][fps=N,][wait=S,][window=TITLE|window-id=0x…|pid=N]` names. Nothing: the
@@ -32,14 +34,7 @@ bool is_x11_capture_spec(std::string_view input);
 // Throws UserError (status 2) for unknown keys and bad values.
 X11CaptureSpec parse_x11_capture_spec(const std::string& input);
 
-// One read of the window: tightly packed RGBA, row 0 the top, alpha 255.
-struct CapturedImage {
-  int width = 0, height = 0;
-  std::vector<std::uint8_t> rgba;
-  std::chrono::steady_clock::time_point captured_at;  // when the read finished (CLOCK_MONOTONIC)
-};
-
-class X11Capture {
+class X11Capture final : public LiveCapture {
  public:
   // Connects and finds the window; waits up to spec.wait_s for a window that is not there (yet)
   // or not mapped. Throws UserError (status 1) when the display cannot be opened, the window is not
@@ -47,19 +42,19 @@ class X11Capture {
   // (they are listed, to choose one by id).
   // `stop` (may be null), set from another thread, ends the wait with status 130.
   explicit X11Capture(const X11CaptureSpec& spec, const std::atomic<bool>* stop = nullptr);
-  ~X11Capture();
+  ~X11Capture() override;
   X11Capture(const X11Capture&) = delete;
   X11Capture& operator=(const X11Capture&) = delete;
 
   // The contents now (the first frame), without waiting for a change.
-  CapturedImage read();
+  CapturedImage read() override;
   // Waits up to `wait` for the contents to change, then reads them; nothing when they did not
   // change in that time or the window is gone (closed()). Follows the window's resizes.
-  std::optional<CapturedImage> read_when_changed(std::chrono::milliseconds wait);
+  std::optional<CapturedImage> read_when_changed(std::chrono::milliseconds wait) override;
   // The window was destroyed or unmapped (the game ended).
-  bool closed() const;
+  bool closed() const override;
   // "window 0x1e00002 \"Doom 3\"" or "the screen of :0".
-  const std::string& description() const;
+  const std::string& description() const override;
 
  private:
   struct State;

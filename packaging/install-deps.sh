@@ -13,6 +13,9 @@ packages=(
   glslang-tools xvfb xauth
   # live capture (x11: windows through Composite, Damage and MIT-SHM)
   libxcomposite-dev libxdamage-dev libxext-dev
+  # live capture (pipewire: a PipeWire video node); the daemon, its tools and GStreamer's
+  # videotestsrc into pipewiresink are what the tests start as a node to read
+  libpipewire-0.3-dev pipewire-bin gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-pipewire
   # synthetic key presses for the window tests of `nelf calibrate`
   xdotool
   # media: FFmpeg libraries, the ffmpeg CLI for test media and benchmarks, OpenImageIO

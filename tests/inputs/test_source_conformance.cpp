@@ -64,10 +64,11 @@ const std::map<std::string, std::function<DriverInputs(const TempDir&)>>& input_
   return makers;
 }
 
-// Live rows read an X server, which unit tests do not have: their contract (info() against the
-// frames, no seek, one line for bad inputs) is checked against real windows in the window suite,
-// tests/inputs/window/test_x11_source.cpp and (a quad-buffer game's eyes) test_glx_stereo_source.cpp.
-const std::vector<std::string> kLiveRows = {"x11", "glx-stereo"};
+// Live rows read an X server or a PipeWire daemon, which unit tests do not have: their contract
+// (info() against the frames, no seek, one line for bad inputs) is checked against real windows in
+// the window suite, tests/inputs/window/test_x11_source.cpp and (a quad-buffer game's eyes)
+// test_glx_stereo_source.cpp, and against a real daemon and node in tests/cli/test_pipewire_cli.cpp.
+const std::vector<std::string> kLiveRows = {"x11", "glx-stereo", "pipewire"};
 
 std::vector<std::string> driver_names() {
   std::vector<std::string> names;
