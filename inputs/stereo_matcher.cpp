@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -125,26 +126,38 @@ cv::Mat block_match_right(cv::StereoBM& bm, const cv::Mat& left, const cv::Mat& 
 
 // Left-right consistency: a left pixel keeps its disparity only if the right pixel it lands on
 // points back to it (within `tolerance`), and the other way round; what fails is occluded or
-// mismatched and becomes unknown.
+// mismatched and becomes unknown. Rows are independent: each is checked, then changed.
 void cross_check(cv::Mat& left, cv::Mat& right, float tolerance) {
-  const cv::Mat l0 = left.clone(), r0 = right.clone();
   const int w = left.cols;
-  for (int y = 0; y < left.rows; ++y) {
-    const auto* lr = l0.ptr<float>(y);
-    const auto* rr = r0.ptr<float>(y);
-    auto* lo = left.ptr<float>(y);
-    auto* ro = right.ptr<float>(y);
-    for (int x = 0; x < w; ++x) {
-      if (!std::isnan(lr[x])) {
-        const long xr = std::lround(static_cast<float>(x) - lr[x]);
-        if (xr < 0 || xr >= w || std::isnan(rr[xr]) || std::abs(rr[xr] - lr[x]) > tolerance) lo[x] = unknown;
+  // Where x − d lands, rounded: offset by the width so that truncation rounds down (|d| < width).
+  const auto landing = [w](int x, float d) {
+    return static_cast<int>(static_cast<float>(x) - d + 0.5f + static_cast<float>(w)) - w;
+  };
+  cv::parallel_for_(cv::Range(0, left.rows), [&](const cv::Range& rows) {
+    std::vector<std::uint8_t> drop_left(static_cast<std::size_t>(w)), drop_right(static_cast<std::size_t>(w));
+    for (int y = rows.start; y < rows.end; ++y) {
+      auto* lr = left.ptr<float>(y);
+      auto* rr = right.ptr<float>(y);
+      for (int x = 0; x < w; ++x) {
+        bool drop = false;
+        if (const float d = lr[x]; !std::isnan(d)) {
+          const int xr = landing(x, d);
+          drop = xr < 0 || xr >= w || !(std::abs(rr[xr] - d) <= tolerance);  // NaN fails too
+        }
+        drop_left[static_cast<std::size_t>(x)] = drop;
+        drop = false;
+        if (const float d = rr[x]; !std::isnan(d)) {
+          const int xl = landing(x, -d);
+          drop = xl < 0 || xl >= w || !(std::abs(lr[xl] - d) <= tolerance);
+        }
+        drop_right[static_cast<std::size_t>(x)] = drop;
       }
-      if (!std::isnan(rr[x])) {
-        const long xl = std::lround(static_cast<float>(x) + rr[x]);
-        if (xl < 0 || xl >= w || std::isnan(lr[xl]) || std::abs(lr[xl] - rr[x]) > tolerance) ro[x] = unknown;
+      for (int x = 0; x < w; ++x) {
+        if (drop_left[static_cast<std::size_t>(x)]) lr[x] = unknown;
+        if (drop_right[static_cast<std::size_t>(x)]) rr[x] = unknown;
       }
     }
-  }
+  });
 }
 
 double matched_share(const cv::Mat& d) {
@@ -199,34 +212,49 @@ void upsample(const cv::Mat& d, const cv::Mat& low, const cv::Mat& guide, ViewDi
     return t;
   };
   const std::vector<Tap> columns = taps(guide.cols, d.cols), rows_at = taps(guide.rows, d.rows);
-  std::array<float, 256> similarity{};
+  // The similarity of two gray levels, indexed by their difference. A sample without a match has the
+  // key no_match, more than 256 from any level, where the similarity is 0: the loop below needs no
+  // test for NaN.
+  constexpr int no_match = 512;
+  std::array<float, no_match + 1> similarity{};
   constexpr float sigma = 10.f;
   for (int i = 0; i < 256; ++i)
     similarity[static_cast<std::size_t>(i)] = std::exp(-static_cast<float>(i * i) / (2 * sigma * sigma)) + 1e-4f;
+  // Each sample as its gray level (or no_match beyond any level) and its disparity (0 without a match).
+  cv::Mat keys(d.size(), CV_16S), values(d.size(), CV_32F);
+  for (int y = 0; y < d.rows; ++y) {
+    const float* src = d.ptr<float>(y);
+    const std::uint8_t* level = low.ptr<std::uint8_t>(y);
+    auto* key = keys.ptr<std::int16_t>(y);
+    auto* value = values.ptr<float>(y);
+    for (int x = 0; x < d.cols; ++x) {
+      const bool matched = !std::isnan(src[x]);
+      key[x] = static_cast<std::int16_t>(matched ? level[x] : no_match);
+      value[x] = matched ? src[x] : 0.f;
+    }
+  }
   cv::parallel_for_(cv::Range(0, guide.rows), [&](const cv::Range& rows) {
     for (int y = rows.start; y < rows.end; ++y) {
       const Tap ty = rows_at[static_cast<std::size_t>(y)];
-      const float* d0 = d.ptr<float>(ty.i0);
-      const float* d1 = d.ptr<float>(ty.i1);
-      const std::uint8_t* l0 = low.ptr<std::uint8_t>(ty.i0);
-      const std::uint8_t* l1 = low.ptr<std::uint8_t>(ty.i1);
+      const float* v0 = values.ptr<float>(ty.i0);
+      const float* v1 = values.ptr<float>(ty.i1);
+      const std::int16_t* k0 = keys.ptr<std::int16_t>(ty.i0);
+      const std::int16_t* k1 = keys.ptr<std::int16_t>(ty.i1);
       const std::uint8_t* g = guide.ptr<std::uint8_t>(y);
       float* dst = out.d.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width);
       for (int x = 0; x < guide.cols; ++x) {
         const Tap tx = columns[static_cast<std::size_t>(x)];
         const int level = g[x];
-        const auto weight = [&](float v, std::uint8_t sample_level, float spatial) {
-          return std::isnan(v) ? 0.f
-                               : spatial * similarity[static_cast<std::size_t>(std::abs(level - int{sample_level}))];
+        const auto similar = [&](std::int16_t key) {
+          const int difference = key - level;
+          return similarity[static_cast<std::size_t>(difference < 0 ? -difference : difference)];
         };
-        const float v00 = d0[tx.i0], v01 = d0[tx.i1], v10 = d1[tx.i0], v11 = d1[tx.i1];
-        const float w00 = weight(v00, l0[tx.i0], (1 - ty.w) * (1 - tx.w));
-        const float w01 = weight(v01, l0[tx.i1], (1 - ty.w) * tx.w);
-        const float w10 = weight(v10, l1[tx.i0], ty.w * (1 - tx.w));
-        const float w11 = weight(v11, l1[tx.i1], ty.w * tx.w);
+        const float w00 = (1 - ty.w) * (1 - tx.w) * similar(k0[tx.i0]);
+        const float w01 = (1 - ty.w) * tx.w * similar(k0[tx.i1]);
+        const float w10 = ty.w * (1 - tx.w) * similar(k1[tx.i0]);
+        const float w11 = ty.w * tx.w * similar(k1[tx.i1]);
         const float weights = w00 + w01 + w10 + w11;
-        const float sum = (w00 > 0 ? w00 * v00 : 0.f) + (w01 > 0 ? w01 * v01 : 0.f) + (w10 > 0 ? w10 * v10 : 0.f) +
-                          (w11 > 0 ? w11 * v11 : 0.f);
+        const float sum = w00 * v0[tx.i0] + w01 * v0[tx.i1] + w10 * v1[tx.i0] + w11 * v1[tx.i1];
         dst[x] = weights > 0 ? sum / weights * scale : unknown;
       }
     }
@@ -237,12 +265,67 @@ struct Range {
   int min_d = 0, num_d = 16;
 };
 
+// A disparity range as shares of the width: low (behind the screen, negative) to high.
+struct DisparityShares {
+  double low = 0, high = 0;
+};
+
+// The range probe runs again after this many frames of one shot, so that what comes into the
+// picture beyond the tracked range is found within half a second.
+constexpr int reprobe_frames = 12;
+
+// The 1st and 99th percentiles of the matched disparities of `d` (of every `step`-th pixel of every
+// `step`-th row), as shares of `width`; nothing when fewer than `min_share` of them matched.
+std::optional<DisparityShares> percentiles(const cv::Mat& d, int width, double min_share, int step = 1) {
+  std::vector<float> found;
+  std::size_t seen = 0;
+  found.reserve(d.total() / static_cast<std::size_t>(step * step) + 1);
+  for (int y = 0; y < d.rows; y += step) {
+    const auto* row = d.ptr<float>(y);
+    for (int x = 0; x < d.cols; x += step, ++seen)
+      if (!std::isnan(row[x])) found.push_back(row[x]);
+  }
+  if (found.empty() || static_cast<double>(found.size()) < min_share * static_cast<double>(seen)) return std::nullopt;
+  const auto quantile = [&](double q) {
+    auto at = found.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(found.size() - 1));
+    std::nth_element(found.begin(), at, found.end());
+    return static_cast<double>(*at) / width;
+  };
+  return DisparityShares{quantile(0.01), quantile(0.99)};
+}
+
+// Whether the matched disparities of `d` keep off the ends of the search `range`: at most 1 % of
+// them within a pixel of either end.
+bool within_range(const cv::Mat& d, const Range& range) {
+  const float low = static_cast<float>(range.min_d) + 1.f, high = static_cast<float>(range.min_d + range.num_d) - 2.f;
+  std::size_t matched = 0, at_ends = 0;
+  for (int y = 0; y < d.rows; ++y) {
+    const auto* row = d.ptr<float>(y);
+    for (int x = 0; x < d.cols; ++x)
+      if (!std::isnan(row[x])) {
+        ++matched;
+        at_ends += row[x] <= low || row[x] >= high;
+      }
+  }
+  return at_ends * 100 <= matched;
+}
+
+double mean_change(const cv::Mat& a, const cv::Mat& b) {
+  cv::Mat change;
+  cv::absdiff(a, b, change);
+  return cv::mean(change)[0];
+}
+
 }  // namespace
 
 struct StereoMatcher::State {
   cv::Ptr<cv::StereoBM> bm = cv::StereoBM::create(16, 9);
   // The previous frame at the working resolution: views and cross-checked, tempered maps.
   cv::Mat left_gray, right_gray, left_d, right_d;
+  // The range the next frame of the shot starts from, and the frames since the last probe.
+  std::optional<DisparityShares> tracked;
+  int frames_since_probe = 0;
+  double matched_at_probe = 0;  // the share of the view the estimate matched on the probed frame
   // The 960×540 maps handed out, written again once no frame holds them.
   ReusableDisparityMaps maps;
 };
@@ -263,6 +346,7 @@ StereoMatcher::~StereoMatcher() = default;
 void StereoMatcher::reset() {
   auto& s = *state_;
   s.left_gray = s.right_gray = s.left_d = s.right_d = cv::Mat();
+  s.tracked.reset();
 }
 
 std::shared_ptr<const StereoDisparity> StereoMatcher::estimate(const StereoVideoFrame& frame) {
@@ -284,46 +368,59 @@ std::shared_ptr<const StereoDisparity> StereoMatcher::estimate(const StereoVideo
     return std::max(1, static_cast<int>(std::lround(static_cast<double>(width) * gh / gw)));
   };
 
-  // The disparity range, from a wide search at a coarse resolution: from 1/4 of the width behind
-  // the screen to 1/2 in front.
+  // The disparity range, as shares of the width: the 1st and 99th percentiles of the disparities
+  // found, widened by the probe's error. While a video goes on (no cut since the last frame, whose
+  // estimate kept inside its range, and fewer than reprobe_frames since the last probe) it is the
+  // last estimate's own, which saves the probe; otherwise a wide search at a coarse resolution
+  // finds it: from 1/4 of the width behind the screen to 1/2 in front.
   const int wp = std::min(probe_width, gw), hp = height_at(wp);
-  const cv::Mat left_probe = area_resize(left_guide, wp, hp), right_probe = area_resize(right_guide, wp, hp);
   auto& bm = *s.bm;
-  bm.setBlockSize(7);
-  bm.setSpeckleWindowSize(wp * hp / 1000);
-  const int probe_min = -round_up_16(wp / 4);
-  const cv::Mat probe = block_match(bm, left_probe, right_probe, probe_min, round_up_16(wp / 2) - probe_min);
-  std::vector<float> found;
-  found.reserve(probe.total());
-  for (int y = 0; y < probe.rows; ++y)
-    for (int x = 0; x < probe.cols; ++x)
-      if (const float v = probe.at<float>(y, x); !std::isnan(v)) found.push_back(v);
-  if (static_cast<double>(found.size()) < settings_.min_matched_share * static_cast<double>(probe.total())) {
-    reset();
-    return nullptr;
-  }
-  const auto quantile = [&](double q) {
-    auto at = found.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(found.size() - 1));
-    std::nth_element(found.begin(), at, found.end());
-    return static_cast<double>(*at) / wp;  // as a share of the width
-  };
-  const double low_share = quantile(0.01), high_share = quantile(0.99);
-
-  // The working width: the largest whose search over that range fits the cost budget.
+  DisparityShares shares;
   const auto range_at = [&](int width) {
     const int margin = 2 + (3 * width + wp - 1) / wp;  // the probe's error, at this width
     Range r;
-    r.min_d = static_cast<int>(std::floor(low_share * width)) - margin;
-    r.num_d = round_up_16(static_cast<int>(std::ceil(high_share * width)) + margin - r.min_d);
+    r.min_d = static_cast<int>(std::floor(shares.low * width)) - margin;
+    r.num_d = round_up_16(static_cast<int>(std::ceil(shares.high * width)) + margin - r.min_d);
     return r;
   };
-  int wk = std::max(std::min(settings_.max_working_width, gw), std::min(settings_.min_working_width, gw));
-  while (wk > std::min(settings_.min_working_width, gw) &&
-         static_cast<double>(wk) * height_at(wk) * range_at(wk).num_d > settings_.cost_budget)
-    wk -= 16;
-  const int hk = height_at(wk);
+  // The working views: the largest width whose search over the range fits the cost budget.
+  int wk = 0, hk = 0;
+  cv::Mat left_gray, right_gray;
+  const auto make_working_views = [&] {
+    wk = std::max(std::min(settings_.max_working_width, gw), std::min(settings_.min_working_width, gw));
+    while (wk > std::min(settings_.min_working_width, gw) &&
+           static_cast<double>(wk) * height_at(wk) * range_at(wk).num_d > settings_.cost_budget)
+      wk -= 16;
+    hk = height_at(wk);
+    left_gray = area_resize(left_guide, wk, hk);
+    right_gray = area_resize(right_guide, wk, hk);
+  };
+  constexpr double cut = 12;  // mean change of a scene cut, in levels of 255
+  bool goes_on = false;       // the same shot as the last frame, at the same working size
+  if (settings_.temporal_weight > 0 && s.tracked && s.frames_since_probe < reprobe_frames) {
+    shares = *s.tracked;
+    make_working_views();
+    goes_on = left_gray.size() == s.left_gray.size() && mean_change(left_gray, s.left_gray) < cut;
+  }
+  if (!goes_on) {
+    const cv::Mat left_probe = area_resize(left_guide, wp, hp), right_probe = area_resize(right_guide, wp, hp);
+    bm.setBlockSize(7);
+    bm.setSpeckleWindowSize(wp * hp / 1000);
+    const int probe_min = -round_up_16(wp / 4);
+    const auto found = percentiles(block_match(bm, left_probe, right_probe, probe_min, round_up_16(wp / 2) - probe_min),
+                                   wp, settings_.min_matched_share);
+    if (!found) {
+      reset();
+      return nullptr;
+    }
+    shares = *found;
+    s.frames_since_probe = 0;
+    make_working_views();
+    goes_on = settings_.temporal_weight > 0 && left_gray.size() == s.left_gray.size() &&
+              mean_change(left_gray, s.left_gray) < cut;
+  }
+  ++s.frames_since_probe;
   const Range range = range_at(wk);
-  const cv::Mat left_gray = area_resize(left_guide, wk, hk), right_gray = area_resize(right_guide, wk, hk);
 
   bm.setBlockSize(wk >= 320 ? 9 : 7);
   bm.setSpeckleWindowSize(wk * hk / 1000);
@@ -335,15 +432,18 @@ std::shared_ptr<const StereoDisparity> StereoMatcher::estimate(const StereoVideo
     return nullptr;
   }
 
-  if (settings_.temporal_weight > 0 && s.left_gray.size() == left_gray.size()) {
-    cv::Mat change;
-    cv::absdiff(left_gray, s.left_gray, change);
-    constexpr double cut = 12;  // mean change of a scene cut, in levels of 255
-    if (cv::mean(change)[0] < cut) {
-      const auto w = static_cast<float>(settings_.temporal_weight);
-      temper(left_d, left_gray, s.left_d, s.left_gray, w);
-      temper(right_d, right_gray, s.right_d, s.right_gray, w);
-    }
+  // The range the next frame starts from: this estimate's own, unless it pressed on the ends of the
+  // search or matched markedly less of the view than the probed frame did (something may lie beyond
+  // the range: the next frame probes again).
+  const double matched = matched_share(left_d);
+  if (s.frames_since_probe == 1) s.matched_at_probe = matched;
+  s.tracked = settings_.temporal_weight > 0 && within_range(left_d, range) && matched >= 0.9 * s.matched_at_probe
+                  ? percentiles(left_d, wk, settings_.min_matched_share, 4)
+                  : std::nullopt;
+  if (goes_on) {
+    const auto w = static_cast<float>(settings_.temporal_weight);
+    temper(left_d, left_gray, s.left_d, s.left_gray, w);
+    temper(right_d, right_gray, s.right_d, s.right_gray, w);
   }
   s.left_gray = left_gray;
   s.right_gray = right_gray;

@@ -46,7 +46,10 @@ struct KnownPair {
   std::vector<float> truth_left, truth_right;
 };
 
-KnownPair planes_pair(int width, int height, int background_d, int plane_d, int bits = 8, unsigned seed = 7) {
+// `plane_seed`: the plane's texture (0: seed + 1).
+KnownPair planes_pair(int width, int height, int background_d, int plane_d, int bits = 8, unsigned seed = 7,
+                      unsigned plane_seed = 0) {
+  if (plane_seed == 0) plane_seed = seed + 1;
   const int x0 = width / 3, x1 = width * 2 / 3, y0 = height / 4, y1 = height * 3 / 4;
   const auto on_plane = [&](int x, int y) { return x >= x0 && x < x1 && y >= y0 && y < y1; };
   KnownPair p;
@@ -78,7 +81,7 @@ KnownPair planes_pair(int width, int height, int background_d, int plane_d, int 
       // Left view: the plane, or the background (seen in the right view at x − background_d,
       // unless the plane covers that spot there).
       if (on_plane(x, y)) {
-        put(f.left, i, texture(x - x0, y, seed + 1));
+        put(f.left, i, texture(x - x0, y, plane_seed));
         p.truth_left[i] = static_cast<float>(plane_d);
       } else {
         put(f.left, i, texture(x, y, seed));
@@ -87,7 +90,7 @@ KnownPair planes_pair(int width, int height, int background_d, int plane_d, int 
       }
       // Right view: the plane where its left-view point x + plane_d is on it, else the background.
       if (on_plane(x + plane_d, y)) {
-        put(f.right, i, texture(x + plane_d - x0, y, seed + 1));
+        put(f.right, i, texture(x + plane_d - x0, y, plane_seed));
         p.truth_right[i] = static_cast<float>(plane_d);
       } else {
         put(f.right, i, texture(x + background_d, y, seed));
@@ -296,6 +299,31 @@ TEST(StereoMatcher, TemperedOnStillVideoAndFollowsACut) {
   const auto d = matcher.estimate(cut.frame);
   ASSERT_TRUE(d);
   expect_accurate(*d, cut, 4.f);
+}
+
+TEST(StereoMatcher, TheRangeOfAShotFollowsAPlaneThatComesCloser) {
+  // Within a shot the search range is the last estimate's own (the probe is saved); a plane that
+  // jumps far beyond it, with no cut, leaves much of the view unmatched, and the next frame probes
+  // again: the plane is found one frame late, at the latest at the probe's interval of 12 frames.
+  StereoMatcher matcher;
+  for (unsigned frame = 0; frame < 4; ++frame)
+    ASSERT_TRUE(matcher.estimate(planes_pair(960, 540, -6, 30, 8, 7, 8 + frame).frame));
+  const auto accurate = [](const StereoDisparity& d, const KnownPair& p) {
+    for (const auto& [map, truth] : {std::pair{&d.left, &p.truth_left}, std::pair{&d.right, &p.truth_right}}) {
+      const Accuracy a = accuracy(*map, *truth, p.frame.width, p.frame.height, -6.f);
+      if (a.median_error > 0.5 || a.bad_share > 0.02 || a.unknown_share > 0.12 || a.occlusion_garbage > 0.10)
+        return false;
+    }
+    return true;
+  };
+  int late = 0;
+  for (; late < 12; ++late) {
+    const KnownPair p = planes_pair(960, 540, -6, 150, 8, 7, 20 + static_cast<unsigned>(late));
+    const auto d = matcher.estimate(p.frame);
+    ASSERT_TRUE(d);
+    if (accurate(*d, p)) break;
+  }
+  EXPECT_EQ(late, 1) << "frames before the plane at 150 px was found";
 }
 
 TEST(StereoMatcher, RefusesViewsThatDoNotHoldTheFramesPixelsAndSkipsTinyOnes) {
