@@ -212,49 +212,34 @@ void upsample(const cv::Mat& d, const cv::Mat& low, const cv::Mat& guide, ViewDi
     return t;
   };
   const std::vector<Tap> columns = taps(guide.cols, d.cols), rows_at = taps(guide.rows, d.rows);
-  // The similarity of two gray levels, indexed by their difference. A sample without a match has the
-  // key no_match, more than 256 from any level, where the similarity is 0: the loop below needs no
-  // test for NaN.
-  constexpr int no_match = 512;
-  std::array<float, no_match + 1> similarity{};
+  std::array<float, 256> similarity{};
   constexpr float sigma = 10.f;
   for (int i = 0; i < 256; ++i)
     similarity[static_cast<std::size_t>(i)] = std::exp(-static_cast<float>(i * i) / (2 * sigma * sigma)) + 1e-4f;
-  // Each sample as its gray level (or no_match beyond any level) and its disparity (0 without a match).
-  cv::Mat keys(d.size(), CV_16S), values(d.size(), CV_32F);
-  for (int y = 0; y < d.rows; ++y) {
-    const float* src = d.ptr<float>(y);
-    const std::uint8_t* level = low.ptr<std::uint8_t>(y);
-    auto* key = keys.ptr<std::int16_t>(y);
-    auto* value = values.ptr<float>(y);
-    for (int x = 0; x < d.cols; ++x) {
-      const bool matched = !std::isnan(src[x]);
-      key[x] = static_cast<std::int16_t>(matched ? level[x] : no_match);
-      value[x] = matched ? src[x] : 0.f;
-    }
-  }
   cv::parallel_for_(cv::Range(0, guide.rows), [&](const cv::Range& rows) {
     for (int y = rows.start; y < rows.end; ++y) {
       const Tap ty = rows_at[static_cast<std::size_t>(y)];
-      const float* v0 = values.ptr<float>(ty.i0);
-      const float* v1 = values.ptr<float>(ty.i1);
-      const std::int16_t* k0 = keys.ptr<std::int16_t>(ty.i0);
-      const std::int16_t* k1 = keys.ptr<std::int16_t>(ty.i1);
+      const float* d0 = d.ptr<float>(ty.i0);
+      const float* d1 = d.ptr<float>(ty.i1);
+      const std::uint8_t* l0 = low.ptr<std::uint8_t>(ty.i0);
+      const std::uint8_t* l1 = low.ptr<std::uint8_t>(ty.i1);
       const std::uint8_t* g = guide.ptr<std::uint8_t>(y);
       float* dst = out.d.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width);
       for (int x = 0; x < guide.cols; ++x) {
         const Tap tx = columns[static_cast<std::size_t>(x)];
         const int level = g[x];
-        const auto similar = [&](std::int16_t key) {
-          const int difference = key - level;
-          return similarity[static_cast<std::size_t>(difference < 0 ? -difference : difference)];
+        const auto weight = [&](float v, std::uint8_t sample_level, float spatial) {
+          return std::isnan(v) ? 0.f
+                               : spatial * similarity[static_cast<std::size_t>(std::abs(level - int{sample_level}))];
         };
-        const float w00 = (1 - ty.w) * (1 - tx.w) * similar(k0[tx.i0]);
-        const float w01 = (1 - ty.w) * tx.w * similar(k0[tx.i1]);
-        const float w10 = ty.w * (1 - tx.w) * similar(k1[tx.i0]);
-        const float w11 = ty.w * tx.w * similar(k1[tx.i1]);
+        const float v00 = d0[tx.i0], v01 = d0[tx.i1], v10 = d1[tx.i0], v11 = d1[tx.i1];
+        const float w00 = weight(v00, l0[tx.i0], (1 - ty.w) * (1 - tx.w));
+        const float w01 = weight(v01, l0[tx.i1], (1 - ty.w) * tx.w);
+        const float w10 = weight(v10, l1[tx.i0], ty.w * (1 - tx.w));
+        const float w11 = weight(v11, l1[tx.i1], ty.w * tx.w);
         const float weights = w00 + w01 + w10 + w11;
-        const float sum = w00 * v0[tx.i0] + w01 * v0[tx.i1] + w10 * v1[tx.i0] + w11 * v1[tx.i1];
+        const float sum = (w00 > 0 ? w00 * v00 : 0.f) + (w01 > 0 ? w01 * v01 : 0.f) + (w10 > 0 ? w10 * v10 : 0.f) +
+                          (w11 > 0 ? w11 * v11 : 0.f);
         dst[x] = weights > 0 ? sum / weights * scale : unknown;
       }
     }
