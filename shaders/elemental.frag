@@ -6,8 +6,9 @@
 // Compiled in six variants (compositor/gl/shader_programs.cpp lists them, and the build validates
 // each): as is for pass 1 (point samples over the whole region), with NELF_AREA_SAMPLE for the
 // border strips, NELF_COORDINATE_MAP for pass 1's coordinate map, NELF_AREA_SAMPLE +
-// NELF_RECORD_TAPS for the CPU composite table, and NELF_DEPTH (with or without NELF_AREA_SAMPLE)
-// for pass 1 and the strips of the depth-aware composite. Compile-time switches: llvmpipe would otherwise
+// NELF_RECORD_TAPS for the CPU composite table, NELF_DEPTH (with or without NELF_AREA_SAMPLE)
+// for pass 1 and the strips of the depth-aware composite, and NELF_DEPTH_MAP for its pass 1's
+// depth coordinate map (elemental_depth_lookup.frag). Compile-time switches: llvmpipe would otherwise
 // evaluate both sides of a run-time choice for every pixel.
 //
 // Memory layout: row 0 of the target region is the top row of the eye image (as in nelf::Image);
@@ -25,50 +26,8 @@ const int u_subsamples = NELF_SUBSAMPLES;
 
 out vec4 colour;
 
-#ifdef NELF_DEPTH
-// The depth-aware composite (optics/depth.hpp, DisparitySurface::hit, the same search in float):
-// each ray shows the view where it meets the content's surface rather than the flat screen.
-layout(binding = 2) uniform sampler2D u_disparity;  // R32F: δ / W per map texel, unknown ones filled
-layout(location = 1) uniform vec2 u_parallax_gain;  // uv shift per mm of pupil crossing per unit of δ / W
-layout(location = 2) uniform vec2 u_disparity_range;  // back (smallest), front (largest) δ / W
-layout(location = 3) uniform float u_pupil_per_lens;  // d_e / d_l: chief ray's pupil crossing = c − (s − c) · this
-const int depth_search_steps = 24;                   // optics/depth.hpp: depth_search_steps
-const int depth_search_bisections = 3;               // and depth_search_bisections
-
-float surface_disparity(vec2 uv) {
-  const ivec2 size = textureSize(u_disparity, 0);
-  return texelFetch(u_disparity, clamp(ivec2(floor(uv * vec2(size))), ivec2(0), size - 1), 0).r;
-}
-
-// The front-most crossing of the ray (meeting the flat screen at flat_uv, shifted by gain per unit
-// of δ / W) with the surface.
-vec2 surface_uv(vec2 flat_uv, vec2 gain) {
-  const float back = u_disparity_range.x, front = u_disparity_range.y;
-  if (!(front > back) || surface_disparity(flat_uv + gain * front) >= front) return flat_uv + gain * front;
-  float hit = back, before = front;
-  // optics/depth.hpp: depth_search_steps_for the texels the ray crosses.
-  const vec2 size = vec2(textureSize(u_disparity, 0));
-  const float extent = (front - back) * max(abs(gain.x) * size.x, abs(gain.y) * size.y);
-  const float wanted = ceil(2.0 * extent);
-  const int steps = wanted >= float(depth_search_steps) ? depth_search_steps : wanted <= 2.0 ? 2 : int(wanted);
-  for (int i = 1; i <= depth_search_steps; ++i) {  // a constant bound (llvmpipe), left at `steps`
-    if (i > steps) break;
-    const float d = front - (front - back) * float(i) / float(steps);
-    if (surface_disparity(flat_uv + gain * d) >= d) {
-      hit = d;
-      break;
-    }
-    before = d;
-  }
-  for (int k = 0; k < depth_search_bisections; ++k) {
-    const float mid = 0.5 * (hit + before);
-    if (surface_disparity(flat_uv + gain * mid) >= mid)
-      hit = mid;
-    else
-      before = mid;
-  }
-  return flat_uv + gain * hit;
-}
+#if defined(NELF_DEPTH) || defined(NELF_DEPTH_MAP)
+#include "depth_search.glsl"
 #endif
 
 bool inside(vec2 uv) { return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))); }
@@ -173,6 +132,22 @@ layout(location = 0) uniform int u_part;
 void main() {
   area_sample(floor(gl_FragCoord.xy - u_region_origin) + 0.5, 1.0);
   colour = recorded[u_part];
+}
+#elif defined(NELF_DEPTH_MAP)
+// The depth coordinate map (one sample per pixel, lens arrays only): for each pixel, where its chief
+// ray meets the flat screen (RG, screen uv) and where it crosses the pupil plane (BA, mm), the two
+// inputs of surface_uv that do not change from frame to frame; a screen uv of -1e9 where the display
+// is black. elemental_depth_lookup.frag then only searches and taps.
+void main() {
+  const vec2 s = display_position(floor(gl_FragCoord.xy - u_region_origin) + 0.5);
+  const ivec2 lens = ivec2(floor(lattice_position(s) + 0.5));
+  vec2 uv;
+  if (!lens_coordinate(s, lens, uv)) {
+    colour = vec4(-1.0e9, -1.0e9, 0.0, 0.0);
+    return;
+  }
+  const vec2 c = u_lattice_offset + rotate(vec2(lens) * u_lens_pitch, 1.0);
+  colour = vec4(uv, c - (s - c) * u_pupil_per_lens);
 }
 #elif defined(NELF_COORDINATE_MAP)
 // The coordinate map (one sub-sample per pixel, prefiltered view): for each pixel, where pass 1

@@ -221,6 +221,20 @@ void GlCompositor::draw_coordinate_map(const EyeMapping& m, const TextureTransfo
   glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
+void GlCompositor::draw_depth_map(const EyeMapping& m, CoordinateMap& map) {
+  map.fbo.reset();
+  map.texture = gl::make_texture_2d(GL_RGBA32F, m.panel[0], m.panel[1]);
+  map.fbo = gl::make_framebuffer(map.texture);
+  upload_mapping(m, TextureTransform{}, 0, 0);
+  glProgramUniform1f(program(shaders::ProgramKind::depth_map), shaders::location::depth::pupil_per_lens,
+                     f(m.eye_relief_mm / m.gap_mm));
+  glBindVertexArray(empty_vertex_array_.id());
+  glBindFramebuffer(GL_FRAMEBUFFER, map.fbo.id());
+  glViewport(0, 0, m.panel[0], m.panel[1]);
+  glUseProgram(program(shaders::ProgramKind::depth_map));
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
 void GlCompositor::render_eye(Eye eye, const GlTextureView& view, const GlTarget& target) {
   render(eye, view, {1, 1}, target);
 }
@@ -262,11 +276,20 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
   const bool new_map =
       use_map && (!coordinate_maps_[e].texture || coordinate_maps_[e].width != view.width ||
                   coordinate_maps_[e].height != view.height || coordinate_maps_[e].aspect != view.aspect());
+  // The depth-aware pass 1 at fsaa 1 likewise fetches what of each pixel's ray does not change (its
+  // flat-screen point and pupil crossing) from a map made once, and only searches and taps.
+  const bool use_depth_map = depth && plan.enabled && subsamples == 1;
+  const bool new_depth_map =
+      use_depth_map && (!depth_maps_[e].texture || depth_maps_[e].width != view.width ||
+                        depth_maps_[e].height != view.height || depth_maps_[e].aspect != view.aspect());
   const bool border_strips = options_.fsaa != 0 && m.has_lens_array;
   glBindVertexArray(empty_vertex_array_.id());
-  CoordinateMap& map = coordinate_maps_[e];
-  if (new_map) {
-    draw_coordinate_map(m, texture, map);
+  CoordinateMap& map = use_depth_map ? depth_maps_[e] : coordinate_maps_[e];
+  if (new_map || new_depth_map) {
+    if (new_map)
+      draw_coordinate_map(m, texture, map);
+    else
+      draw_depth_map(m, map);
     map.width = view.width;
     map.height = view.height;
     map.aspect = view.aspect();
@@ -275,7 +298,8 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
   if (depth) {
     const DisparitySurface& surface = *depth_[e].surface;
     const Vec2 gain = pupil_gain(depth_geometry(profile_, m), {1.0, 1.0});
-    for (shaders::ProgramKind kind : {shaders::ProgramKind::depth, shaders::ProgramKind::depth_border}) {
+    for (shaders::ProgramKind kind :
+         {shaders::ProgramKind::depth, shaders::ProgramKind::depth_border, shaders::ProgramKind::depth_lookup}) {
       namespace at = shaders::location::depth;
       glProgramUniform2f(program(kind), at::parallax_gain, f(gain.x), f(gain.y));
       glProgramUniform2f(program(kind), at::disparity_range, surface.back(), surface.front());
@@ -294,6 +318,10 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
     glProgramUniform2f(program(shaders::ProgramKind::lookup), shaders::location::lookup_region_origin, f(target.x),
                        f(target.y));
     glUseProgram(program(shaders::ProgramKind::lookup));
+  } else if (use_depth_map) {
+    glBindSampler(shaders::second_unit, 0);
+    glBindTextureUnit(shaders::second_unit, map.texture.id());
+    glUseProgram(program(shaders::ProgramKind::depth_lookup));
   } else {
     glUseProgram(program(depth ? shaders::ProgramKind::depth : shaders::ProgramKind::elemental));
   }

@@ -163,6 +163,8 @@ class GlCompositor final : public Compositor {
   // Fills the mapping's uniform block (shaders/mapping.glsl) for the next draw.
   void upload_mapping(const EyeMapping& m, const TextureTransform& texture, int x, int y);
   void draw_coordinate_map(const EyeMapping& m, const TextureTransform& texture, CoordinateMap& map);
+  // The depth coordinate map (elemental.frag's NELF_DEPTH_MAP) of `m` into `map`.
+  void draw_depth_map(const EyeMapping& m, CoordinateMap& map);
   // Runs the prefilter passes; returns the texture the elemental pass samples. `reduced`: the
   // texture already holds the block means (the first pass is skipped).
   GLuint prefilter(const PrefilterPlan& plan, GLuint view_texture, int view_width, int view_height, bool reduced,
@@ -179,6 +181,7 @@ class GlCompositor final : public Compositor {
   GLuint program(shaders::ProgramKind kind);
   std::array<gl::Program, shaders::every_program_kind.size()> programs_;
   std::array<CoordinateMap, 2> coordinate_maps_;       // per eye, fsaa 1
+  std::array<CoordinateMap, 2> depth_maps_;            // per eye, fsaa 1 with depth
   std::array<PrefilterTargets, 2> prefilter_targets_;  // per eye
   std::array<UploadedView, 2> uploads_;                // per eye, for compose()
   std::array<EyeTarget, 2> eye_targets_;               // per eye, for compose()

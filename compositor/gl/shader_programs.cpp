@@ -31,6 +31,10 @@ std::string_view kind_name(ProgramKind kind) {
       return "depth";
     case ProgramKind::depth_border:
       return "depth_border";
+    case ProgramKind::depth_map:
+      return "depth_map";
+    case ProgramKind::depth_lookup:
+      return "depth_lookup";
     case ProgramKind::defect_gather:
       return "defect_gather";
     case ProgramKind::defect_apply:
@@ -72,6 +76,11 @@ ProgramSource program_source(ProgramKind kind, int subsamples) {
       return {"fullscreen.vert", "elemental.frag", per_axis + "#define NELF_DEPTH 1\n"};
     case ProgramKind::depth_border:
       return {"border_strips.vert", "elemental.frag", per_axis + "#define NELF_AREA_SAMPLE 1\n#define NELF_DEPTH 1\n"};
+    // One sample per pixel: both exist only for fsaa 1.
+    case ProgramKind::depth_map:
+      return {"fullscreen.vert", "elemental.frag", "#define NELF_DEPTH_MAP 1\n"};
+    case ProgramKind::depth_lookup:
+      return {"fullscreen.vert", "elemental_depth_lookup.frag", {}};
     case ProgramKind::defect_gather:
       return {"defect_gather.vert", "defect_gather.frag", {}};
     case ProgramKind::defect_apply:
