@@ -61,12 +61,12 @@ std::vector<DefectVisibility> measure_defect_visibility(const EyeSimulator& simu
   // The defects' screen points; defects outside the lit elemental images show nothing anyone sees.
   std::vector<Vec2> screen_points(defects.size());
   std::vector<bool> lit(defects.size(), false);
+  // (Stuck pixels beside the lit block too, whose lens shows them on the screen: defect_screen_point.)
   for (std::size_t n = 0; n < defects.size(); ++n) {
-    const Vec2 s = display_position_mm(rendering, defects[n].x + 0.5, defects[n].y + 0.5);
-    const auto owner = owner_lens_centre(rendering, s);
-    if (!owner || !view_coordinate(rendering, s)) continue;
+    const auto v = defect_screen_point(rendering, defects[n]);
+    if (!v) continue;
     lit[n] = true;
-    screen_points[n] = {owner->x + (s.x - owner->x) * k, owner->y + (s.y - owner->y) * k};
+    screen_points[n] = *v;
   }
 
   struct Accumulator {

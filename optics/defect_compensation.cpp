@@ -88,6 +88,21 @@ Vec2 lens_centre(const EyeMapping& m, LensIndex lens) {
   return {m.lattice_offset_mm.x + c.x, m.lattice_offset_mm.y + c.y};
 }
 
+// The lens in front of display position s, lit or not (owner_lens_centre's lattice, unbounded).
+LensIndex physical_lens(const EyeMapping& m, Vec2 s) {
+  const double to_lens_plane = m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm);
+  const Vec2 q = rotate({s.x * to_lens_plane - m.lattice_offset_mm.x, s.y * to_lens_plane - m.lattice_offset_mm.y},
+                        m.rotation_cos, -m.rotation_sin);
+  return {static_cast<int>(std::floor(q.x / m.lens_pitch_mm + 0.5)),
+          static_cast<int>(std::floor(q.y / m.lens_pitch_mm + 0.5))};
+}
+
+// Whether screen point v (mm) is on the emulated screen.
+bool on_screen(const EyeMapping& m, Vec2 v) {
+  return std::abs(v.x - m.screen_centre_mm.x) <= m.screen_size_mm.x / 2.0 &&
+         std::abs(v.y - m.screen_centre_mm.y) <= m.screen_size_mm.y / 2.0;
+}
+
 bool lit_lens(const EyeMapping& m, LensIndex lens) {
   return lens.m >= m.first_lens[0] && lens.m < m.first_lens[0] + m.lenses[0] && lens.n >= m.first_lens[1] &&
          lens.n < m.first_lens[1] + m.lenses[1];
@@ -212,6 +227,22 @@ std::vector<std::array<int, 2>> defect_bundle_pixels(const EyeMapping& m, int x,
   return pixels;
 }
 
+std::optional<Vec2> defect_screen_point(const EyeMapping& m, const PixelDefect& d) {
+  if (!m.has_lens_array) return std::nullopt;
+  const Vec2 s = display_position_mm(m, d.x + 0.5, d.y + 0.5);
+  const bool lit = view_coordinate(m, s).has_value();
+  // A stuck pixel outside the lit elemental images is sent black but shows its value, through the
+  // lens in front of it, to a screen point that lit pixels of other lenses show too: from the eye
+  // box's edge its beam enters the pupil (a stuck white pixel beside the lit block put a 19.6 % spot
+  // on another defect's window, docs/defects.md). A dead one there shows what it is sent.
+  if (!lit && d.kind != DefectKind::stuck) return std::nullopt;
+  const Vec2 c = lens_centre(m, physical_lens(m, s));
+  const double k = (m.render_distance_mm - m.eye_relief_mm) / m.gap_mm;
+  const Vec2 v{c.x + (s.x - c.x) * k, c.y + (s.y - c.y) * k};
+  if (!lit && !on_screen(m, v)) return std::nullopt;
+  return v;
+}
+
 EyeDefectPlan plan_defect_compensation(const EyeMapping& mapping, const DefectMap& map,
                                        const DefectPlanOptions& options) {
   EyeDefectPlan plan;
@@ -231,7 +262,6 @@ EyeDefectPlan plan_defect_compensation(const EyeMapping& mapping, const DefectMa
   // The pupil positions in the lattice's frame, where the lens squares are axis-aligned.
   std::vector<Vec2> pupils_in_lattice;
   for (const Vec2& q : pupils) pupils_in_lattice.push_back(rotate(q, mapping.rotation_cos, -mapping.rotation_sin));
-  const double k = mapping.has_lens_array ? (mapping.render_distance_mm - mapping.eye_relief_mm) / mapping.gap_mm : 0.0;
 
   std::vector<BundleLens> lenses;
   std::vector<Candidate> candidates;
@@ -239,16 +269,20 @@ EyeDefectPlan plan_defect_compensation(const EyeMapping& mapping, const DefectMa
   for (const PixelDefect& d : map.defects) {
     if (d.eye != mapping.eye) continue;
     const Vec2 s = display_position_mm(mapping, d.x + 0.5, d.y + 0.5);
-    if (!view_coordinate(mapping, s)) {
+    if (!mapping.has_lens_array) {  // one pixel per screen point: nothing else shows it
+      if (view_coordinate(mapping, s))
+        ++plan.uncompensable;
+      else
+        ++plan.outside_lit;
+      continue;
+    }
+    const std::optional<Vec2> screen_point = defect_screen_point(mapping, d);
+    if (!screen_point) {
       ++plan.outside_lit;
       continue;
     }
-    if (!mapping.has_lens_array) {  // one pixel per screen point: nothing else shows it
-      ++plan.uncompensable;
-      continue;
-    }
-    const Vec2 own = *owner_lens_centre(mapping, s);
-    const Vec2 v{own.x + (s.x - own.x) * k, own.y + (s.y - own.y) * k};
+    const Vec2 v = *screen_point;
+    const Vec2 own = lens_centre(mapping, physical_lens(mapping, s));
     bundle_of(mapping, lens_index(mapping, own), v, lenses, candidates);
     std::erase_if(candidates, [&](const Candidate& c) { return defective.contains(key(c.x, c.y)); });
 

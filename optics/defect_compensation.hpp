@@ -9,6 +9,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/image.hpp"
@@ -70,6 +71,12 @@ std::vector<Vec2> eye_box_pupil_positions(const EyeMapping& mapping, double pupi
 // stock device. A defect whose pupil-plane beam no position of the eye box sees gets no correction
 // and is counted neither as outside_lit nor as uncompensable.
 std::vector<std::array<int, 2>> defect_bundle_pixels(const EyeMapping& mapping, int x, int y);
+
+// The screen point (mm) whose light defect `d` takes away or adds: through its own lens for a pixel of
+// the lit elemental images; for a stuck pixel outside them (sent black, showing its value), through
+// the lens in front of it when that reaches the screen. Nothing otherwise (no lens array, or a defect
+// no one sees: it needs nothing).
+std::optional<Vec2> defect_screen_point(const EyeMapping& mapping, const PixelDefect& d);
 
 // Per frame, in place, on one eye's composited image (panel size; the defects' own pixels are left
 // as they are, the display shows what it shows there). All corrections are worked out from the

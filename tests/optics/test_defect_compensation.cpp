@@ -84,6 +84,24 @@ TEST(DefectCompensation, ADefectOutsideTheLitElementalImagesNeedsNothing) {
   EXPECT_TRUE(plan.empty());
 }
 
+TEST(DefectCompensation, AStuckPixelBesideTheLitBlockWhoseLensShowsTheScreenIsMadeUp) {
+  // Left 451 14 on hmz-t1 (from docs/defects.md's seed-1 map): outside the lit elemental images, so
+  // it is sent black, but stuck white it sends light through the lens in front of it to a point of
+  // the screen, seen from the eye box's edge. Dead there, it shows what it is sent: nothing to do.
+  const EyeMapping& m = hmz_t1_left();
+  ASSERT_FALSE(view_coordinate_at_pixel(m, 451.5, 14.5));
+  const EyeDefectPlan stuck =
+      plan_defect_compensation(m, DefectMap{{{Eye::left, 451, 14, DefectKind::stuck, {255, 255, 255}}}});
+  EXPECT_EQ(stuck.outside_lit, 0);
+  ASSERT_EQ(stuck.corrections.size(), 1u);
+  EXPECT_GE(stuck.corrections[0].shares.size(), 2u);
+  for (const BundleShare& share : stuck.corrections[0].shares)
+    EXPECT_TRUE(view_coordinate_at_pixel(m, share.x + 0.5, share.y + 0.5)) << "a share on an unlit pixel";
+  const EyeDefectPlan dead_there = plan_defect_compensation(m, DefectMap{{dead(Eye::left, {451, 14})}});
+  EXPECT_EQ(dead_there.outside_lit, 1);
+  EXPECT_TRUE(dead_there.empty());
+}
+
 TEST(DefectCompensation, TheOtherEyesDefectsAreNotPlanned) {
   const EyeMapping& m = hmz_t1_left();
   const EyeDefectPlan plan = plan_defect_compensation(m, DefectMap{{dead(Eye::right, central_lit_pixel(m))}});
