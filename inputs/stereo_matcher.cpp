@@ -380,12 +380,17 @@ std::shared_ptr<const StereoDisparity> StereoMatcher::estimate(const StereoVideo
     left_gray = area_resize(left_guide, wk, hk);
     right_gray = area_resize(right_guide, wk, hk);
   };
-  constexpr double cut = 12;  // mean change of a scene cut, in levels of 255
-  bool goes_on = false;       // the same shot as the last frame, at the same working size
+  // The same shot as the last frame, at the same working size: no mean change of a scene cut (12
+  // levels of 255).
+  const auto same_shot = [&] {
+    return settings_.temporal_weight > 0 && left_gray.size() == s.left_gray.size() &&
+           mean_change(left_gray, s.left_gray) < 12;
+  };
+  bool goes_on = false;
   if (settings_.temporal_weight > 0 && s.tracked && s.frames_since_probe < reprobe_frames) {
     shares = *s.tracked;
     make_working_views();
-    goes_on = left_gray.size() == s.left_gray.size() && mean_change(left_gray, s.left_gray) < cut;
+    goes_on = same_shot();
   }
   if (!goes_on) {
     const cv::Mat left_probe = area_resize(left_guide, wp, hp), right_probe = area_resize(right_guide, wp, hp);
@@ -401,8 +406,7 @@ std::shared_ptr<const StereoDisparity> StereoMatcher::estimate(const StereoVideo
     shares = *found;
     s.frames_since_probe = 0;
     make_working_views();
-    goes_on = settings_.temporal_weight > 0 && left_gray.size() == s.left_gray.size() &&
-              mean_change(left_gray, s.left_gray) < cut;
+    goes_on = same_shot();
   }
   ++s.frames_since_probe;
   const Range range = range_at(wk);
@@ -412,7 +416,8 @@ std::shared_ptr<const StereoDisparity> StereoMatcher::estimate(const StereoVideo
   cv::Mat left_d = block_match(bm, left_gray, right_gray, range.min_d, range.num_d);
   cv::Mat right_d = block_match_right(bm, left_gray, right_gray, range.min_d, range.num_d);
   cross_check(left_d, right_d, 1.f);
-  if (matched_share(left_d) < settings_.min_matched_share || matched_share(right_d) < settings_.min_matched_share) {
+  const double matched = matched_share(left_d);
+  if (matched < settings_.min_matched_share || matched_share(right_d) < settings_.min_matched_share) {
     reset();
     return nullptr;
   }
@@ -420,7 +425,6 @@ std::shared_ptr<const StereoDisparity> StereoMatcher::estimate(const StereoVideo
   // The range the next frame starts from: this estimate's own, unless it pressed on the ends of the
   // search or matched markedly less of the view than the probed frame did (something may lie beyond
   // the range: the next frame probes again).
-  const double matched = matched_share(left_d);
   if (s.frames_since_probe == 1) s.matched_at_probe = matched;
   s.tracked = settings_.temporal_weight > 0 && within_range(left_d, range) && matched >= 0.9 * s.matched_at_probe
                   ? percentiles(left_d, wk, settings_.min_matched_share, 4)

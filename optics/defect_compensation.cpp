@@ -88,15 +88,6 @@ Vec2 lens_centre(const EyeMapping& m, LensIndex lens) {
   return {m.lattice_offset_mm.x + c.x, m.lattice_offset_mm.y + c.y};
 }
 
-// The lens in front of display position s, lit or not (owner_lens_centre's lattice, unbounded).
-LensIndex physical_lens(const EyeMapping& m, Vec2 s) {
-  const double to_lens_plane = m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm);
-  const Vec2 q = rotate({s.x * to_lens_plane - m.lattice_offset_mm.x, s.y * to_lens_plane - m.lattice_offset_mm.y},
-                        m.rotation_cos, -m.rotation_sin);
-  return {static_cast<int>(std::floor(q.x / m.lens_pitch_mm + 0.5)),
-          static_cast<int>(std::floor(q.y / m.lens_pitch_mm + 0.5))};
-}
-
 // Whether screen point v (mm) is on the emulated screen.
 bool on_screen(const EyeMapping& m, Vec2 v) {
   return std::abs(v.x - m.screen_centre_mm.x) <= m.screen_size_mm.x / 2.0 &&
@@ -236,7 +227,7 @@ std::optional<Vec2> defect_screen_point(const EyeMapping& m, const PixelDefect& 
   // box's edge its beam enters the pupil (a stuck white pixel beside the lit block put a 19.6 % spot
   // on another defect's window, docs/defects.md). A dead one there shows what it is sent.
   if (!lit && d.kind != DefectKind::stuck) return std::nullopt;
-  const Vec2 c = lens_centre(m, physical_lens(m, s));
+  const Vec2 c = lens_centre_in_front(m, s);
   const double k = (m.render_distance_mm - m.eye_relief_mm) / m.gap_mm;
   const Vec2 v{c.x + (s.x - c.x) * k, c.y + (s.y - c.y) * k};
   if (!lit && !on_screen(m, v)) return std::nullopt;
@@ -282,7 +273,7 @@ EyeDefectPlan plan_defect_compensation(const EyeMapping& mapping, const DefectMa
       continue;
     }
     const Vec2 v = *screen_point;
-    const Vec2 own = lens_centre(mapping, physical_lens(mapping, s));
+    const Vec2 own = lens_centre_in_front(mapping, s);
     bundle_of(mapping, lens_index(mapping, own), v, lenses, candidates);
     std::erase_if(candidates, [&](const Candidate& c) { return defective.contains(key(c.x, c.y)); });
 

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -111,18 +112,31 @@ Vec2 display_position_mm(const EyeMapping& m, double x, double y) {
           (m.panel[1] / 2.0 - y + m.shift_px.y) * m.pixel_pitch_mm.y};
 }
 
-std::optional<Vec2> owner_lens_centre(const EyeMapping& m, Vec2 s) {
+namespace {
+// The lattice index (m, n) of the lens in front of display position s.
+std::array<int, 2> lens_in_front(const EyeMapping& m, Vec2 s) {
   // Each lens's elemental image is the lens lattice projected from the pupil onto the display.
   const double to_lens_plane = m.eye_relief_mm / (m.eye_relief_mm + m.gap_mm);
   const Vec2 q =
       rotate(m, {s.x * to_lens_plane - m.lattice_offset_mm.x, s.y * to_lens_plane - m.lattice_offset_mm.y}, -1.0);
-  const int lens_m = static_cast<int>(std::floor(q.x / m.lens_pitch_mm + 0.5));
-  const int lens_n = static_cast<int>(std::floor(q.y / m.lens_pitch_mm + 0.5));
+  return {static_cast<int>(std::floor(q.x / m.lens_pitch_mm + 0.5)),
+          static_cast<int>(std::floor(q.y / m.lens_pitch_mm + 0.5))};
+}
+
+Vec2 centre_of_lens(const EyeMapping& m, std::array<int, 2> lens) {
+  const Vec2 c = rotate(m, {lens[0] * m.lens_pitch_mm, lens[1] * m.lens_pitch_mm}, 1.0);
+  return Vec2{m.lattice_offset_mm.x + c.x, m.lattice_offset_mm.y + c.y};
+}
+}  // namespace
+
+Vec2 lens_centre_in_front(const EyeMapping& m, Vec2 s) { return centre_of_lens(m, lens_in_front(m, s)); }
+
+std::optional<Vec2> owner_lens_centre(const EyeMapping& m, Vec2 s) {
+  const auto [lens_m, lens_n] = lens_in_front(m, s);
   if (lens_m < m.first_lens[0] || lens_m >= m.first_lens[0] + m.lenses[0] || lens_n < m.first_lens[1] ||
       lens_n >= m.first_lens[1] + m.lenses[1])
     return std::nullopt;
-  const Vec2 c = rotate(m, {lens_m * m.lens_pitch_mm, lens_n * m.lens_pitch_mm}, 1.0);
-  return Vec2{m.lattice_offset_mm.x + c.x, m.lattice_offset_mm.y + c.y};
+  return centre_of_lens(m, {lens_m, lens_n});
 }
 
 std::optional<Vec2> view_coordinate(const EyeMapping& m, Vec2 s) {

@@ -45,6 +45,10 @@ EyeMapping make_eye_mapping(const Profile& profile, Eye eye, double content_aspe
 // pixel coordinate (x, y); pixel (i, j) has its centre at (i + 0.5, j + 0.5), y grows downwards.
 Vec2 display_position_mm(const EyeMapping& m, double x, double y);
 
+// Centre (lens plane, mm) of the lens in front of display position s, whether its elemental image is
+// lit or not.
+Vec2 lens_centre_in_front(const EyeMapping& m, Vec2 s);
+
 // Centre (lens plane, mm) of the lens owning display position s, or nothing when s is outside the
 // central N_l,x × N_l,y block of elemental images.
 std::optional<Vec2> owner_lens_centre(const EyeMapping& m, Vec2 s);
