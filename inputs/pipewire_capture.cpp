@@ -24,6 +24,7 @@
 
 #include "core/printable.hpp"
 #include "core/user_error.hpp"
+#include "inputs/screencast_portal.hpp"
 
 namespace nelf {
 namespace {
@@ -36,7 +37,7 @@ bool parse_number(std::string_view text, T& value) {
   return ec == std::errc() && end == text.data() + text.size();
 }
 
-constexpr const char* kKeys = "node=ID or NAME, fps=, wait=";
+constexpr const char* kKeys = "node=ID or NAME, fps=, wait=, restore=yes|no";
 
 struct ThreadLoopDeleter {
   void operator()(pw_thread_loop* l) const { pw_thread_loop_destroy(l); }
@@ -57,6 +58,7 @@ struct ProxyDeleter {
 // The video nodes the daemon announces.
 struct NodeInfo {
   std::string name, description, media_class;
+  std::string serial;  // object.serial: what target.object names (an id is reused, a serial is not)
 };
 
 std::string describe(unsigned id, const NodeInfo& node) {
@@ -100,6 +102,7 @@ bool is_pipewire_capture_spec(std::string_view input) {
 
 PipeWireCaptureSpec parse_pipewire_capture_spec(const std::string& input) {
   PipeWireCaptureSpec spec;
+  bool restore_given = false;
   std::string_view rest = input == "pipewire" ? std::string_view() : std::string_view(input).substr(9);
   while (!rest.empty()) {
     const std::size_t eq = rest.find('=');
@@ -127,13 +130,17 @@ PipeWireCaptureSpec parse_pipewire_capture_spec(const std::string& input) {
       double fps = 0;
       if (!parse_number(value, fps) || !(fps >= 1 && fps <= 1000)) throw bad("a rate from 1 to 1000 frames a second");
       spec.fps = fps;
+    } else if (key == "restore") {
+      if (value != "yes" && value != "no") throw bad("yes or no");
+      spec.restore = value == "yes";
+      restore_given = true;
     } else {
       throw UserError(fmt::format("{}: unknown key {} ({})", input, key, kKeys), 2);
     }
   }
-  if (!spec.node_id && spec.node_name.empty())
-    throw UserError(fmt::format("{}: name the node: pipewire:node=ID or NAME (pw-cli ls Node lists them); the "
-                                "desktop's ScreenCast portal is not read yet",
+  if (restore_given && (spec.node_id || !spec.node_name.empty()))
+    throw UserError(fmt::format("{}: restore= is about the ScreenCast portal's kept choice; a node named with node= "
+                                "has none",
                                 input),
                     2);
   return spec;
@@ -143,6 +150,8 @@ struct PipeWireCapture::State {
   std::string input;
   PipeWireCaptureSpec spec;
   std::string description;
+  // The portal's screen cast, when the node is its choice; ended after everything below.
+  std::unique_ptr<ScreenCastPortal> portal;
 
   // Declared in the order they are made; ~State stops the loop's thread first, then they go in reverse.
   std::unique_ptr<pw_thread_loop, ThreadLoopDeleter> loop;
@@ -206,7 +215,8 @@ struct PipeWireCapture::State {
       const char* v = spa_dict_lookup(props, key);
       return std::string(v ? v : "");
     };
-    s->nodes[id] = {get(PW_KEY_NODE_NAME), get(PW_KEY_NODE_DESCRIPTION), get(PW_KEY_MEDIA_CLASS)};
+    s->nodes[id] = {get(PW_KEY_NODE_NAME), get(PW_KEY_NODE_DESCRIPTION), get(PW_KEY_MEDIA_CLASS),
+                    get(PW_KEY_OBJECT_SERIAL)};
     pw_thread_loop_signal(s->loop.get(), false);
   }
   static void on_global_remove(void* data, uint32_t id) {
@@ -217,7 +227,7 @@ struct PipeWireCapture::State {
   static void on_stream_state(void* data, pw_stream_state /*old*/, pw_stream_state state, const char* error) {
     auto* s = static_cast<State*>(data);
     if (state == PW_STREAM_STATE_ERROR) s->end(fmt::format("PipeWire: {}", error ? error : "stream error"));
-    if (state == PW_STREAM_STATE_PAUSED && !s->link) s->link_to_target();
+    if (state == PW_STREAM_STATE_PAUSED && !s->link && !s->portal) s->link_to_target();
   }
   static void on_link_info(void* data, const pw_link_info* info) {
     auto* s = static_cast<State*>(data);
@@ -371,13 +381,28 @@ PipeWireCapture::PipeWireCapture(const PipeWireCaptureSpec& spec, std::string in
   if (pw_thread_loop_start(s.loop.get()) < 0)
     throw UserError(fmt::format("{}: cannot start PipeWire's loop", printable(in)), 1);
 
+  // Without a node, the user's choice in the desktop's dialog, before anything waits on the loop.
+  if (!spec.node_id && spec.node_name.empty()) {
+    s.portal = std::make_unique<ScreenCastPortal>(ScreenCastPortalOptions{spec.restore}, s.input, stop);
+    s.spec.node_id = s.portal->node_id();
+  }
+
   pw_thread_loop_lock(s.loop.get());
   struct Unlock {
     pw_thread_loop* loop;
     ~Unlock() { pw_thread_loop_unlock(loop); }
   } unlock{s.loop.get()};
 
-  s.core.reset(pw_context_connect(s.context.get(), nullptr, 0));
+  if (s.portal) {
+    UniqueFd fd = s.portal->take_pipewire_fd();
+    s.core.reset(pw_context_connect_fd(s.context.get(), fd.release(), nullptr, 0));
+    if (!s.core)
+      throw UserError(fmt::format("{}: cannot connect to PipeWire through the portal's connection ({})", printable(in),
+                                  std::strerror(errno)),
+                      1);
+  } else {
+    s.core.reset(pw_context_connect(s.context.get(), nullptr, 0));
+  }
   if (!s.core)
     throw UserError(fmt::format("{}: cannot connect to PipeWire ({}); is its daemon running in this session?",
                                 printable(in), std::strerror(errno)),
@@ -409,18 +434,29 @@ PipeWireCapture::PipeWireCapture(const PipeWireCaptureSpec& spec, std::string in
   if (!s.failure.empty()) throw UserError(fmt::format("{}: {}", printable(in), s.failure), 1);
   s.wait_for([&] { return (target = s.find_target()).has_value(); },
              start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(spec.wait_s)), stop);
+  if (!target && s.portal)
+    throw UserError(fmt::format("{}: the screen cast's PipeWire node {} is not visible through the portal's "
+                                "connection",
+                                printable(in), *s.spec.node_id),
+                    1);
   if (!target)
     throw UserError(fmt::format("{}: no PipeWire node {}{}; the video nodes: {}", printable(in),
                                 spec.node_id ? std::to_string(*spec.node_id) : printable(spec.node_name),
                                 spec.wait_s > 0 ? fmt::format(" after {} s", spec.wait_s) : "", s.video_nodes()),
                     1);
   s.target = *target;
-  s.description = fmt::format("PipeWire node {}", describe(s.target, s.nodes.at(s.target)));
+  s.description = s.portal
+                      ? fmt::format("the desktop's screen cast{} (PipeWire node {})",
+                                    s.portal->source_type().empty() ? "" : " of a " + s.portal->source_type(), s.target)
+                      : fmt::format("PipeWire node {}", describe(s.target, s.nodes.at(s.target)));
 
-  // nelf's input stream, linked to the node by nelf itself (not left to a session manager).
-  s.stream.reset(pw_stream_new(s.core.get(), "nelf",
-                               pw_properties_new(PW_KEY_MEDIA_TYPE, "Video", PW_KEY_MEDIA_CATEGORY, "Capture",
-                                                 PW_KEY_MEDIA_ROLE, "Screen", nullptr)));
+  // nelf's input stream: linked to a named node by nelf itself (not left to a session manager); the
+  // portal's connection sees nothing but the cast's node, so that link is the session manager's.
+  pw_properties* stream_props = pw_properties_new(PW_KEY_MEDIA_TYPE, "Video", PW_KEY_MEDIA_CATEGORY, "Capture",
+                                                  PW_KEY_MEDIA_ROLE, "Screen", nullptr);
+  if (s.portal && !s.nodes.at(s.target).serial.empty())
+    pw_properties_set(stream_props, PW_KEY_TARGET_OBJECT, s.nodes.at(s.target).serial.c_str());
+  s.stream.reset(pw_stream_new(s.core.get(), "nelf", stream_props));
   if (!s.stream) throw UserError(fmt::format("{}: cannot create a PipeWire stream", printable(in)), 1);
   static const pw_stream_events stream_events = [] {
     pw_stream_events e{};
@@ -448,7 +484,9 @@ PipeWireCapture::PipeWireCapture(const PipeWireCaptureSpec& spec, std::string in
       SPA_FORMAT_VIDEO_size, SPA_POD_CHOICE_RANGE_Rectangle(&size_default, &size_min, &size_max),
       SPA_FORMAT_VIDEO_framerate, SPA_POD_CHOICE_RANGE_Fraction(&rate_default, &rate_min, &rate_max)));
 #pragma GCC diagnostic pop
-  if (pw_stream_connect(s.stream.get(), PW_DIRECTION_INPUT, PW_ID_ANY, PW_STREAM_FLAG_MAP_BUFFERS, &formats, 1) < 0)
+  const auto flags = static_cast<pw_stream_flags>(PW_STREAM_FLAG_MAP_BUFFERS |
+                                                  (s.portal ? PW_STREAM_FLAG_AUTOCONNECT : PW_STREAM_FLAG_NONE));
+  if (pw_stream_connect(s.stream.get(), PW_DIRECTION_INPUT, s.portal ? s.target : PW_ID_ANY, flags, &formats, 1) < 0)
     throw UserError(fmt::format("{}: cannot connect a PipeWire stream", printable(in)), 1);
 }
 
@@ -468,6 +506,10 @@ CapturedImage PipeWireCapture::read() {
   const bool readable = s.order.has_value();
   pw_thread_loop_unlock(s.loop.get());
   if (why.empty() && negotiated && !readable) why = "it sends a pixel format nelf does not read (8-bit RGB only)";
+  if (why.empty() && !negotiated && s.portal)
+    why =
+        "nothing linked nelf to the cast's node in 10 s (the desktop's session manager does: is WirePlumber or "
+        "pipewire-media-session running?)";
   if (why.empty()) why = "no frame came from the node in 10 s (is it producing? a paused game sends none)";
   throw UserError(fmt::format("{}: {}: {}", printable(s.input), s.description, why), 1);
 }

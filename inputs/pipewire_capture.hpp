@@ -1,9 +1,11 @@
 #pragma once
-// Reading a PipeWire video node as it produces frames, for the `pipewire:` source: a compositor's
-// or a game's screen-cast stream (gamescope, a Wayland compositor's ScreenCast node, anything
-// `pw-cli ls Node` lists as Video/Source). nelf links its own input stream to the node, so no
-// session manager is needed and none links nelf to anything else; frames come in shared memory
-// (MemFd or MemPtr buffers) in any 8-bit RGB order and are read as RGBA.
+// Reading a PipeWire video node as it produces frames, for the `pipewire:` source: the screen or
+// window the user chooses in the desktop's ScreenCast portal (inputs/screencast_portal), or a node
+// named directly (gamescope's, anything `pw-cli ls Node` lists as Video/Source). A named node is
+// linked by nelf itself, so no session manager is needed and none links nelf to anything else; the
+// portal's stream is linked by the desktop's session manager, as the portal's connection sees only
+// that node. Frames come in shared memory (MemFd or MemPtr buffers) in any 8-bit RGB order and are
+// read as RGBA.
 #include <atomic>
 #include <chrono>
 #include <memory>
@@ -15,26 +17,29 @@
 
 namespace nelf {
 
-// What `pipewire:node=ID|NAME[,fps=N][,wait=S]` names.
+// What `pipewire:[node=ID|NAME][,fps=N][,wait=S][,restore=no]` names; without a node, the
+// ScreenCast portal's choice.
 struct PipeWireCaptureSpec {
   std::optional<unsigned> node_id;  // the node's id (pw-cli ls Node)
   std::string node_name;            // or its node.name / node.description
+  bool restore = true;              // portal: take back the choice kept from the last run
   double fps = 60.0;                // the most frames a second that are read
   double wait_s = 0.0;              // how long to wait for the node to appear
 };
 
 bool is_pipewire_capture_spec(std::string_view input);
-// Throws UserError (status 2) for unknown keys, bad values and a spec without node= (the desktop's
-// ScreenCast portal is not read yet).
+// Throws UserError (status 2) for unknown keys and bad values.
 PipeWireCaptureSpec parse_pipewire_capture_spec(const std::string& input);
 
 class PipeWireCapture final : public LiveCapture {
  public:
-  // Connects to the PipeWire daemon ($PIPEWIRE_REMOTE, $PIPEWIRE_RUNTIME_DIR or $XDG_RUNTIME_DIR, as
-  // every PipeWire client does), finds the node (waiting up to spec.wait_s for it), links a stream to
-  // it and waits for its first frame. Throws UserError: status 1 when there is no daemon, no such
-  // node, the node offers no format nelf reads or sends no frame; status 2 when a name matches several
-  // nodes (they are listed, to choose one by id). `stop` (may be null) ends a wait with status 130.
+  // For a named node: connects to the PipeWire daemon ($PIPEWIRE_REMOTE, $PIPEWIRE_RUNTIME_DIR or
+  // $XDG_RUNTIME_DIR, as every PipeWire client does), finds the node (waiting up to spec.wait_s for
+  // it) and links a stream to it. Without one: asks the ScreenCast portal and connects through the
+  // connection it opens. Throws UserError: status 1 when there is no daemon, no such node, the node
+  // offers no format nelf reads or sends no frame, the portal is missing or the cast refused; status 2
+  // when a name matches several nodes (they are listed, to choose one by id). `stop` (may be null)
+  // ends a wait with status 130.
   PipeWireCapture(const PipeWireCaptureSpec& spec, std::string input, const std::atomic<bool>* stop = nullptr);
   ~PipeWireCapture() override;
   PipeWireCapture(const PipeWireCapture&) = delete;

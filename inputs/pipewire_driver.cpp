@@ -1,5 +1,6 @@
-// The pipewire driver: `pipewire:node=ID|NAME` — a PipeWire video node (a compositor's or a game's
-// screen-cast stream) as a stereo source (inputs/pipewire_capture, inputs/live_capture.hpp).
+// The pipewire driver: `pipewire:` — the screen or window the user chooses in the desktop's
+// ScreenCast portal — and `pipewire:node=ID|NAME`, a PipeWire video node (a game's screen-cast
+// stream), as a stereo source (inputs/pipewire_capture, inputs/screencast_portal, inputs/live_capture.hpp).
 #include <memory>
 
 #include "inputs/live_capture.hpp"

@@ -29,7 +29,9 @@ constexpr SourceDriver kDrivers[] = {
      drivers::accepts_synthetic, drivers::open_synthetic},
     {"x11", "x11:[display=:N,fps=N,wait=S,][window=TITLE|window-id=0x…]: a live X11 window (or the screen)",
      drivers::accepts_x11, drivers::open_x11},
-    {"pipewire", "pipewire:node=ID|NAME[,fps=N,wait=S]: a PipeWire video node (gamescope, a compositor's screen cast)",
+    {"pipewire",
+     "pipewire:[node=ID|NAME,fps=N,wait=S,restore=no]: the screen or window chosen in the desktop's ScreenCast "
+     "portal, or a PipeWire video node (gamescope)",
      drivers::accepts_pipewire, drivers::open_pipewire},
     {"glx-stereo",
      "glx-stereo:[wait=S,]socket=PATH: a quad-buffer OpenGL game's two eyes, from nelf's interposer in the game "

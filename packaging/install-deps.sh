@@ -16,6 +16,10 @@ packages=(
   # live capture (pipewire: a PipeWire video node); the daemon, its tools and GStreamer's
   # videotestsrc into pipewiresink are what the tests start as a node to read
   libpipewire-0.3-dev pipewire-bin gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-pipewire
+  # live capture (pipewire: alone: the desktop's ScreenCast portal over D-Bus through sd-bus); the
+  # tests run the real xdg-desktop-portal on a private session bus, a test backend of their own
+  # answering the user's dialog (tests/desktop/), and WirePlumber to link the portal's stream
+  libsystemd-dev xdg-desktop-portal wireplumber dbus-daemon
   # synthetic key presses for the window tests of `nelf calibrate`
   xdotool
   # media: FFmpeg libraries, the ffmpeg CLI for test media and benchmarks, OpenImageIO
