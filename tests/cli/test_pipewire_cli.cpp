@@ -3,6 +3,10 @@
 // every client) and GStreamer's videotestsrc into pipewiresink as the node, and stops them.
 // GStreamer's pipewiresink (Debian 12) sends nothing more once its first reader has left, so each
 // nelf run reads a node of its own.
+//
+// `pipewire:` alone goes through a desktop's stack, each test's own: a private session bus, the real
+// xdg-desktop-portal front end it activates, WirePlumber linking the cast, and the desktop's half of
+// the portal played by tests/desktop/screencast_portal_backend.cpp (answering for the user's dialog).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -14,6 +18,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <future>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -165,8 +170,10 @@ TEST_F(PipeWireCliTest, ARecordingEndsCompleteWhenTheNodeGoesAway) {
 
 TEST_F(PipeWireCliTest, BadNodesAreOneLine) {
   start_node("bars", "BGRx");
-  test::expect_clean_failure(dir_, "convert pipewire: out.mkv --frames 1", 2,
-                             "name the node: pipewire:node=ID or NAME (pw-cli ls Node lists them)");
+  test::expect_clean_failure(dir_, "convert pipewire:node=bars,restore=no out.mkv --frames 1", 2,
+                             "restore= is about the ScreenCast portal's kept choice");
+  test::expect_clean_failure(dir_, "convert pipewire:restore=maybe out.mkv --frames 1", 2,
+                             "restore=maybe is not yes or no");
   test::expect_clean_failure(dir_, "convert pipewire:node=bars,fps=0 out.mkv --frames 1", 2,
                              "fps=0 is not a rate from 1 to 1000 frames a second");
   test::expect_clean_failure(dir_, "convert pipewire:node=bars,colour=red out.mkv --frames 1", 2, "unknown key colour");
@@ -184,6 +191,171 @@ TEST_F(PipeWireCliTest, BadNodesAreOneLine) {
     const test::ScopedEnv no_daemon("PIPEWIRE_RUNTIME_DIR", nowhere.path().string());
     test::expect_clean_failure(dir_, "convert pipewire:node=bars out.mkv --frames 1", 1, "cannot connect to PipeWire");
   }
+}
+
+// A desktop session of its own: a session bus whose activated xdg-desktop-portal sees only the test
+// backend (XDG_DESKTOP_PORTAL_DIR, XDG_CURRENT_DESKTOP), keeps its tokens under a private
+// XDG_DATA_HOME, and WirePlumber to link what the portal's connection cannot.
+class PortalCliTest : public PipeWireCliTest {
+ protected:
+  void SetUp() override {
+    PipeWireCliTest::SetUp();
+    if (HasFatalFailure()) return;
+    const auto portals = desktop_ / "portals";
+    std::filesystem::create_directories(portals);
+    write_file(portals / "nelftest.portal",
+               "[portal]\nDBusName=org.freedesktop.impl.portal.desktop.nelftest\n"
+               "Interfaces=org.freedesktop.impl.portal.ScreenCast;\nUseIn=nelf-test\n");
+    portal_dir_.emplace("XDG_DESKTOP_PORTAL_DIR", portals.string());
+    bus_ = start_bus("bus", true);
+    bus_address_.emplace("DBUS_SESSION_BUS_ADDRESS", "unix:path=" + (runtime_ / "bus").string());
+    session_manager_ = std::make_unique<Background>(std::vector<std::string>{"wireplumber"});
+  }
+
+  // A dbus-daemon listening at RUNTIME/name; `services`: it activates what the system installs
+  // (xdg-desktop-portal and its permission store), otherwise nothing.
+  std::unique_ptr<Background> start_bus(const std::string& name, bool services) {
+    const auto config = desktop_ / (name + ".conf");
+    write_file(config, fmt::format("<!DOCTYPE busconfig PUBLIC \"-//freedesktop//DTD D-Bus Bus Configuration 1.0//EN\" "
+                                   "\"http://www.freedesktop.org/standards/dbus/1.0/busconfig.dtd\">\n"
+                                   "<busconfig><type>session</type><listen>unix:path={}</listen>{}"
+                                   "<policy context=\"default\"><allow send_destination=\"*\" eavesdrop=\"true\"/>"
+                                   "<allow eavesdrop=\"true\"/><allow own=\"*\"/></policy></busconfig>\n",
+                                   (runtime_ / name).string(), services ? "<standard_session_servicedirs/>" : ""));
+    auto bus = std::make_unique<Background>(
+        std::vector<std::string>{"dbus-daemon", "--nofork", "--config-file=" + config.string()});
+    for (int i = 0; i < 300 && !std::filesystem::exists(runtime_ / name); ++i) std::this_thread::sleep_for(10ms);
+    EXPECT_TRUE(std::filesystem::exists(runtime_ / name)) << "dbus-daemon did not start";
+    return bus;
+  }
+
+  // The desktop's half of the portal; `answer`: accept, cancel or never (the dialog stays open).
+  void start_backend(const std::string& answer) {
+    backend_ = std::make_unique<Background>(std::vector<std::string>{
+        NELF_TEST_SCREENCAST_BACKEND, "--node-file", (desktop_ / "node").string(), "--width", "640", "--height", "180",
+        "--answer", answer, "--log", (desktop_ / "backend.log").string()});
+    const auto ready = desktop_ / "backend.log.ready";
+    std::filesystem::remove(ready);
+    for (int i = 0; i < 300; ++i) {
+      if (std::filesystem::exists(ready)) return;
+      std::this_thread::sleep_for(20ms);
+    }
+    FAIL() << "the test backend did not take its name on the bus";
+  }
+
+  // A new node as the screen the next cast shows (a desktop makes a node per cast).
+  void next_screen() {
+    const std::string name = fmt::format("screen-{}", screens_++);
+    start_node(name, "BGRx");
+    const auto listed = test::run_command("pw-cli ls Node");
+    const std::size_t at = listed.out.find("node.name = \"" + name + "\"");
+    ASSERT_NE(at, std::string::npos);
+    const std::size_t id = listed.out.rfind("\tid ", at);
+    ASSERT_NE(id, std::string::npos);
+    write_file(desktop_ / "node", std::to_string(std::stoul(listed.out.substr(id + 4))) + "\n");
+  }
+
+  std::string backend_log() const {
+    const auto made = test::run_command("cat " + test::shell_quote((desktop_ / "backend.log").string()));
+    std::string log = made.out;
+    for (char& c : log)
+      if (c == '\n') c = ' ';
+    return log;
+  }
+
+  static void write_file(const std::filesystem::path& path, const std::string& text) {
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    ASSERT_NE(f, nullptr) << path;
+    std::fputs(text.c_str(), f);
+    std::fclose(f);
+  }
+
+  test::TempDir desktop_, data_, state_;
+  test::ScopedEnv runtime_dir_{"XDG_RUNTIME_DIR", runtime_.path().string()};
+  test::ScopedEnv desktop_name_{"XDG_CURRENT_DESKTOP", "nelf-test"};
+  test::ScopedEnv data_home_{"XDG_DATA_HOME", data_.path().string()};
+  test::ScopedEnv state_home_{"XDG_STATE_HOME", state_.path().string()};
+  std::optional<test::ScopedEnv> portal_dir_, bus_address_;
+  std::unique_ptr<Background> bus_, session_manager_, backend_;
+  int screens_ = 0;
+};
+
+TEST_F(PortalCliTest, TheUserIsAskedOnceAndTheChoiceIsKept) {
+  // What the portal casts is recorded as the same picture from a file would be; the portal's restore
+  // token is kept under XDG_STATE_HOME, so the next run takes the choice back without a dialog, and
+  // restore=no asks again.
+  start_backend("accept");
+  const auto still = bars_still();
+  const auto reference = dir_ / "reference.png";
+  ASSERT_EQ(test::run_nelf("convert " + test::shell_quote(still.string()) + " " + test::shell_quote(reference.string()))
+                .status,
+            0);
+  const auto expected = test::read_back(reference);
+  next_screen();
+  const auto out = dir_ / "cast.png";
+  auto r = test::run_nelf("convert pipewire: " + test::shell_quote(out.string()) + " --frames 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("the desktop's screen cast of a monitor (PipeWire node "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("640x180, live, two 320x180 views, layout sbs (aspect)"), std::string::npos) << r.err;
+  const auto got = test::read_back(out);
+  ASSERT_EQ(got.width, expected.width);
+  ASSERT_EQ(got.height, expected.height);
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < got.pixels.size(); ++i)
+    if (std::abs(got.pixels[i] - expected.pixels[i]) > 2.5f / 255) ++differing;
+  EXPECT_EQ(differing, 0u);
+  EXPECT_EQ(backend_log(), "asked started closed ") << "the session is closed when nelf ends";
+  EXPECT_TRUE(std::filesystem::exists(state_ / "nelf" / "screencast-restore-token"));
+
+  next_screen();
+  r = test::run_nelf("convert pipewire: " + test::shell_quote((dir_ / "again.png").string()) + " --frames 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(backend_log(), "asked started closed restored started closed ") << "the kept choice was not restored";
+
+  next_screen();
+  r = test::run_nelf("convert pipewire:restore=no " + test::shell_quote((dir_ / "ask.png").string()) + " --frames 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(backend_log(), "asked started closed restored started closed asked started closed ");
+}
+
+TEST_F(PortalCliTest, ARefusedOrMissingPortalIsOneLine) {
+  start_backend("cancel");
+  next_screen();
+  test::expect_clean_failure(dir_, "convert pipewire: out.mkv --frames 1", 1,
+                             "pipewire:: the screen cast was cancelled");
+  EXPECT_FALSE(std::filesystem::exists(state_ / "nelf" / "screencast-restore-token"));
+  {
+    const auto bare = start_bus("bare-bus", false);
+    const test::ScopedEnv bare_bus("DBUS_SESSION_BUS_ADDRESS", "unix:path=" + (runtime_ / "bare-bus").string());
+    test::expect_clean_failure(dir_, "convert pipewire: out.mkv --frames 1", 1,
+                               "no ScreenCast portal on the session bus");
+  }
+  {
+    const test::ScopedEnv no_bus("DBUS_SESSION_BUS_ADDRESS", "unix:path=" + (runtime_ / "nothing-here").string());
+    test::expect_clean_failure(dir_, "convert pipewire: out.mkv --frames 1", 1, "cannot reach the session bus");
+  }
+  {
+    // The portal's connection sees only the cast's node: without a session manager nothing links it.
+    session_manager_->stop();
+    backend_.reset();
+    start_backend("accept");
+    next_screen();
+    test::expect_clean_failure(dir_, "convert pipewire: out.mkv --frames 1", 1,
+                               "nothing linked nelf to the cast's node in 10 s");
+  }
+}
+
+TEST_F(PortalCliTest, CtrlCWhileTheDialogIsOpenEndsCleanly) {
+  start_backend("never");
+  next_screen();
+  const auto out = dir_ / "out.mkv";
+  const auto r = test::run_command(std::string(NELF_BINARY) + " convert pipewire: " + test::shell_quote(out.string()) +
+                                   " & pid=$!; sleep 2; kill -INT $pid; (sleep 20; kill -KILL $pid) 2>/dev/null & "
+                                   "guard=$!; wait $pid; status=$?; kill $guard 2>/dev/null; exit $status");
+  EXPECT_EQ(r.status, 130) << r.err;
+  EXPECT_NE(r.err.find("pipewire:: interrupted"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 }  // namespace
