@@ -35,8 +35,7 @@ using namespace std::chrono_literals;
 
 // Channels of two same-sized images that differ by more than 8-bit rounding (a live node's frame
 // against nelf's output for the same picture as a file).
-template <typename Image>
-std::size_t differing_channels(const Image& got, const Image& expected) {
+std::size_t differing_channels(const test::ReadBack& got, const test::ReadBack& expected) {
   std::size_t differing = 0;
   for (std::size_t i = 0; i < got.pixels.size(); ++i)
     if (std::abs(got.pixels[i] - expected.pixels[i]) > 2.5f / 255) ++differing;
@@ -118,6 +117,17 @@ class PipeWireCliTest : public ::testing::Test {
     return png;
   }
 
+  // What nelf makes of the bars as a file: the frame a node of the same bars must record as.
+  void convert_bars_still(test::ReadBack& expected) {
+    const auto still = bars_still();
+    const auto reference = dir_ / "reference.png";
+    ASSERT_EQ(
+        test::run_nelf("convert " + test::shell_quote(still.string()) + " " + test::shell_quote(reference.string()))
+            .status,
+        0);
+    expected = test::read_back(reference);
+  }
+
   test::TempDir dir_, runtime_;
   test::ScopedEnv remote_{"PIPEWIRE_RUNTIME_DIR", runtime_.path().string()};
   std::unique_ptr<Background> daemon_;
@@ -127,12 +137,8 @@ class PipeWireCliTest : public ::testing::Test {
 TEST_F(PipeWireCliTest, ANodesFramesAreWhatTheSameStillWouldShow) {
   // Two pixel orders a producer may send (BGRx as Wayland compositors do, RGBx): the frame nelf
   // records from the node is the frame it makes of the same picture as a file.
-  const auto still = bars_still();
-  const auto reference = dir_ / "reference.png";
-  ASSERT_EQ(test::run_nelf("convert " + test::shell_quote(still.string()) + " " + test::shell_quote(reference.string()))
-                .status,
-            0);
-  const auto expected = test::read_back(reference);
+  test::ReadBack expected;
+  ASSERT_NO_FATAL_FAILURE(convert_bars_still(expected));
   for (const std::string format : {"BGRx", "RGBx"}) {
     SCOPED_TRACE(format);
     const std::string name = "bars-" + format;
@@ -292,12 +298,8 @@ TEST_F(PortalCliTest, TheUserIsAskedOnceAndTheChoiceIsKept) {
   // token is kept under XDG_STATE_HOME, so the next run takes the choice back without a dialog, and
   // restore=no asks again.
   start_backend("accept");
-  const auto still = bars_still();
-  const auto reference = dir_ / "reference.png";
-  ASSERT_EQ(test::run_nelf("convert " + test::shell_quote(still.string()) + " " + test::shell_quote(reference.string()))
-                .status,
-            0);
-  const auto expected = test::read_back(reference);
+  test::ReadBack expected;
+  ASSERT_NO_FATAL_FAILURE(convert_bars_still(expected));
   next_screen();
   const auto out = dir_ / "cast.png";
   auto r = test::run_nelf("convert pipewire: " + test::shell_quote(out.string()) + " --frames 1");
