@@ -16,6 +16,7 @@
 #include "app/play_command.hpp"
 #include "compositor/overlays/subtitle_overlay.hpp"
 #include "core/printable.hpp"
+#include "core/state_files.hpp"
 #include "core/user_error.hpp"
 #include "hmz_output/display.hpp"
 #include "hmz_output/display_drivers.hpp"
@@ -216,7 +217,7 @@ PlayEnd play_inputs(const PlayArgs& args, const SourceRequest& base, const std::
   request.allow_network = args.allow_network;
   request.device_options = parse_device_options(args, entries);
   request.max_pixels = args.max_pixels;
-  const WatchLater watch_later(args.remember ? WatchLater::default_state_home() : std::filesystem::path());
+  const WatchLater watch_later(args.remember ? xdg_state_home() : std::filesystem::path());
 
   const bool keys_from_stdin = std::none_of(entries.begin(), entries.end(), reads_stdin);
   std::unique_ptr<Display> display;

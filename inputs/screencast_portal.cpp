@@ -1,13 +1,11 @@
 #include "inputs/screencast_portal.hpp"
 
 #include <fcntl.h>
-#include <sys/stat.h>
 #include <systemd/sd-bus.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "core/printable.hpp"
+#include "core/state_files.hpp"
 #include "core/user_error.hpp"
 
 namespace nelf {
@@ -69,16 +68,14 @@ int read_options(sd_bus_message* m, const std::function<bool(std::string_view)>&
   return sd_bus_message_exit_container(m);
 }
 
-}  // namespace
-
-std::string screencast_restore_token_path() {
-  const char* state = std::getenv("XDG_STATE_HOME");
-  const char* home = std::getenv("HOME");
-  const std::filesystem::path base = state && *state ? std::filesystem::path(state)
-                                     : home && *home ? std::filesystem::path(home) / ".local" / "state"
-                                                     : std::filesystem::path(".");
-  return (base / "nelf" / "screencast-restore-token").string();
+// Where the restore token is kept: $XDG_STATE_HOME/nelf/screencast-restore-token; empty (nothing
+// kept, the user is asked each time) without a state folder.
+std::filesystem::path restore_token_path() {
+  const std::filesystem::path home = xdg_state_home();
+  return home.empty() ? home : home / "nelf" / "screencast-restore-token";
 }
+
+}  // namespace
 
 struct ScreenCastPortal::State {
   std::string input;
@@ -181,26 +178,15 @@ struct ScreenCastPortal::State {
                : value;
   }
 
-  void save_restore_token(const std::string& token) const {
-    const std::filesystem::path path = screencast_restore_token_path();
-    std::error_code ec;
-    std::filesystem::create_directories(path.parent_path(), ec);
-    const std::filesystem::path temporary = path.string() + ".new";
-    {
-      const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
-      if (fd < 0) return;  // a cast without a kept choice: the user is asked again next time
-      const UniqueFd file(fd);
-      const std::string text = token + "\n";
-      if (::write(file.get(), text.data(), text.size()) != static_cast<ssize_t>(text.size())) {
-        std::filesystem::remove(temporary, ec);
-        return;
-      }
-    }
-    std::filesystem::rename(temporary, path, ec);
+  // A choice that cannot be kept only means the user is asked again next time.
+  static void save_restore_token(const std::string& token) {
+    if (const auto path = restore_token_path(); !path.empty()) replace_file(path, token + "\n", 0600);
   }
 
   static std::string kept_restore_token() {
-    std::ifstream file(screencast_restore_token_path());
+    const auto path = restore_token_path();
+    if (path.empty()) return {};
+    std::ifstream file(path);
     std::string token;
     std::getline(file, token);
     return token;

@@ -17,10 +17,6 @@ struct ScreenCastPortalOptions {
   bool restore = true;  // offer the kept restore token (false: ask the user again)
 };
 
-// Where the restore token lives: $XDG_STATE_HOME/nelf/screencast-restore-token, or
-// $HOME/.local/state/nelf/screencast-restore-token.
-std::string screencast_restore_token_path();
-
 // One screen cast, open while the object lives (its portal session is closed with it).
 class ScreenCastPortal {
  public:

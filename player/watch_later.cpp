@@ -1,17 +1,16 @@
 #include "player/watch_later.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <toml++/toml.h>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <sstream>
 #include <system_error>
 #include <type_traits>
 
 #include "core/printable.hpp"
+#include "core/state_files.hpp"
 
 namespace nelf {
 namespace {
@@ -55,12 +54,6 @@ bool WatchLaterRecord::empty() const {
 
 WatchLater::WatchLater(fs::path state_home) {
   if (!state_home.empty()) dir_ = state_home / "nelf" / "watch_later";
-}
-
-fs::path WatchLater::default_state_home() {
-  if (const char* xdg = std::getenv("XDG_STATE_HOME"); xdg && *xdg && fs::path(xdg).is_absolute()) return xdg;
-  if (const char* home = std::getenv("HOME"); home && *home) return fs::path(home) / ".local" / "state";
-  return {};
 }
 
 std::optional<std::string> WatchLater::key_for(const std::string& input) {
@@ -122,19 +115,7 @@ void WatchLater::save(const std::string& key, const WatchLaterRecord& record,
   });
   std::ostringstream text;
   text << "# nelf play: where this file was left and how it was set up\n" << table << "\n";
-  fs::create_directories(dir_, ec);
-  const fs::path temporary = fs::path(file).concat(fmt::format(".{}.tmp", ::getpid()));
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out << text.str();
-    out.flush();
-    if (out) {
-      out.close();
-      fs::rename(temporary, file, ec);
-      if (!ec) return;
-    }
-  }
-  fs::remove(temporary, ec);
+  if (replace_file(file, text.str())) return;
   warn(fmt::format("{}: cannot save where play stopped", printable(file.string())));
 }
 

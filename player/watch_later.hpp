@@ -34,8 +34,6 @@ class WatchLater {
   // The records' folder: `state_home`/nelf/watch_later. `state_home` empty: none (nothing is read
   // or written).
   explicit WatchLater(std::filesystem::path state_home);
-  // $XDG_STATE_HOME when it is an absolute path, else $HOME/.local/state (none without HOME).
-  static std::filesystem::path default_state_home();
 
   // The key of `input`: its absolute path without symlinks, when it is a local file; nullopt for
   // anything else (URLs, `synthetic:`, a live input), which nelf does not remember.
