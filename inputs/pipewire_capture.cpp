@@ -102,7 +102,6 @@ bool is_pipewire_capture_spec(std::string_view input) {
 
 PipeWireCaptureSpec parse_pipewire_capture_spec(const std::string& input) {
   PipeWireCaptureSpec spec;
-  bool restore_given = false;
   std::string_view rest = input == "pipewire" ? std::string_view() : std::string_view(input).substr(9);
   while (!rest.empty()) {
     const std::size_t eq = rest.find('=');
@@ -133,12 +132,11 @@ PipeWireCaptureSpec parse_pipewire_capture_spec(const std::string& input) {
     } else if (key == "restore") {
       if (value != "yes" && value != "no") throw bad("yes or no");
       spec.restore = value == "yes";
-      restore_given = true;
     } else {
       throw UserError(fmt::format("{}: unknown key {} ({})", input, key, kKeys), 2);
     }
   }
-  if (restore_given && (spec.node_id || !spec.node_name.empty()))
+  if (spec.restore && (spec.node_id || !spec.node_name.empty()))
     throw UserError(fmt::format("{}: restore= is about the ScreenCast portal's kept choice; a node named with node= "
                                 "has none",
                                 input),
@@ -383,7 +381,7 @@ PipeWireCapture::PipeWireCapture(const PipeWireCaptureSpec& spec, std::string in
 
   // Without a node, the user's choice in the desktop's dialog, before anything waits on the loop.
   if (!spec.node_id && spec.node_name.empty()) {
-    s.portal = std::make_unique<ScreenCastPortal>(ScreenCastPortalOptions{spec.restore}, s.input, stop);
+    s.portal = std::make_unique<ScreenCastPortal>(ScreenCastPortalOptions{spec.restore.value_or(true)}, s.input, stop);
     s.spec.node_id = s.portal->node_id();
   }
 

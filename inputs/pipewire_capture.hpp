@@ -22,7 +22,7 @@ namespace nelf {
 struct PipeWireCaptureSpec {
   std::optional<unsigned> node_id;  // the node's id (pw-cli ls Node)
   std::string node_name;            // or its node.name / node.description
-  bool restore = true;              // portal: take back the choice kept from the last run
+  std::optional<bool> restore;      // portal: take back the choice kept from the last run (unset: yes)
   double fps = 60.0;                // the most frames a second that are read
   double wait_s = 0.0;              // how long to wait for the node to appear
 };
