@@ -216,9 +216,9 @@ class PortalCliTest : public PipeWireCliTest {
     if (HasFatalFailure()) return;
     const auto portals = desktop_ / "portals";
     std::filesystem::create_directories(portals);
-    write_file(portals / "nelftest.portal",
-               "[portal]\nDBusName=org.freedesktop.impl.portal.desktop.nelftest\n"
-               "Interfaces=org.freedesktop.impl.portal.ScreenCast;\nUseIn=nelf-test\n");
+    test::write_file(portals / "nelftest.portal",
+                     "[portal]\nDBusName=org.freedesktop.impl.portal.desktop.nelftest\n"
+                     "Interfaces=org.freedesktop.impl.portal.ScreenCast;\nUseIn=nelf-test\n");
     portal_dir_.emplace("XDG_DESKTOP_PORTAL_DIR", portals.string());
     bus_ = start_bus("bus", true);
     bus_address_.emplace("DBUS_SESSION_BUS_ADDRESS", "unix:path=" + (runtime_ / "bus").string());
@@ -229,12 +229,13 @@ class PortalCliTest : public PipeWireCliTest {
   // (xdg-desktop-portal and its permission store), otherwise nothing.
   std::unique_ptr<Background> start_bus(const std::string& name, bool services) {
     const auto config = desktop_ / (name + ".conf");
-    write_file(config, fmt::format("<!DOCTYPE busconfig PUBLIC \"-//freedesktop//DTD D-Bus Bus Configuration 1.0//EN\" "
-                                   "\"http://www.freedesktop.org/standards/dbus/1.0/busconfig.dtd\">\n"
-                                   "<busconfig><type>session</type><listen>unix:path={}</listen>{}"
-                                   "<policy context=\"default\"><allow send_destination=\"*\" eavesdrop=\"true\"/>"
-                                   "<allow eavesdrop=\"true\"/><allow own=\"*\"/></policy></busconfig>\n",
-                                   (runtime_ / name).string(), services ? "<standard_session_servicedirs/>" : ""));
+    test::write_file(config,
+                     fmt::format("<!DOCTYPE busconfig PUBLIC \"-//freedesktop//DTD D-Bus Bus Configuration 1.0//EN\" "
+                                 "\"http://www.freedesktop.org/standards/dbus/1.0/busconfig.dtd\">\n"
+                                 "<busconfig><type>session</type><listen>unix:path={}</listen>{}"
+                                 "<policy context=\"default\"><allow send_destination=\"*\" eavesdrop=\"true\"/>"
+                                 "<allow eavesdrop=\"true\"/><allow own=\"*\"/></policy></busconfig>\n",
+                                 (runtime_ / name).string(), services ? "<standard_session_servicedirs/>" : ""));
     auto bus = std::make_unique<Background>(
         std::vector<std::string>{"dbus-daemon", "--nofork", "--config-file=" + config.string()});
     for (int i = 0; i < 300 && !std::filesystem::exists(runtime_ / name); ++i) std::this_thread::sleep_for(10ms);
@@ -265,22 +266,14 @@ class PortalCliTest : public PipeWireCliTest {
     ASSERT_NE(at, std::string::npos);
     const std::size_t id = listed.out.rfind("\tid ", at);
     ASSERT_NE(id, std::string::npos);
-    write_file(desktop_ / "node", std::to_string(std::stoul(listed.out.substr(id + 4))) + "\n");
+    test::write_file(desktop_ / "node", std::to_string(std::stoul(listed.out.substr(id + 4))) + "\n");
   }
 
   std::string backend_log() const {
-    const auto made = test::run_command("cat " + test::shell_quote((desktop_ / "backend.log").string()));
-    std::string log = made.out;
+    std::string log = test::read_file(desktop_ / "backend.log");
     for (char& c : log)
       if (c == '\n') c = ' ';
     return log;
-  }
-
-  static void write_file(const std::filesystem::path& path, const std::string& text) {
-    std::FILE* f = std::fopen(path.c_str(), "w");
-    ASSERT_NE(f, nullptr) << path;
-    std::fputs(text.c_str(), f);
-    std::fclose(f);
   }
 
   test::TempDir desktop_, data_, state_;

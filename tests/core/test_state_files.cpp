@@ -3,20 +3,10 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
-#include <fstream>
-#include <sstream>
-
 #include "support/test_support.hpp"
 
 namespace nelf {
 namespace {
-
-std::string contents(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 TEST(StateFiles, TheStateFolderFollowsXdgAndIgnoresARelativeOne) {
   const test::ScopedEnv home("HOME", "/home/someone");
@@ -39,7 +29,7 @@ TEST(StateFiles, AFileIsReplacedWholeWithItsModeAndNothingBeside) {
   const auto file = dir.path() / "nelf" / "kept";
   ASSERT_TRUE(replace_file(file, "first\n", 0600));
   ASSERT_TRUE(replace_file(file, "second\n", 0600));
-  EXPECT_EQ(contents(file), "second\n");
+  EXPECT_EQ(test::read_file(file), "second\n");
   struct stat st {};
   ASSERT_EQ(::stat(file.c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 0777, 0600u);
@@ -53,7 +43,7 @@ TEST(StateFiles, AFileThatCannotBeReplacedIsLeftAsItWas) {
   // A folder where the file should go: the rename fails, the temporary is removed.
   EXPECT_FALSE(replace_file(dir.path(), "lost\n"));
   EXPECT_FALSE(replace_file(dir.path() / "kept" / "under-a-file", "lost\n"));
-  EXPECT_EQ(contents(file), "kept\n");
+  EXPECT_EQ(test::read_file(file), "kept\n");
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1);
 }
 
