@@ -9,6 +9,7 @@
 #include <cmath>
 #include <functional>
 #include <stdexcept>
+#include <string_view>
 #include <system_error>
 
 extern "C" {
@@ -55,6 +56,15 @@ const AVCodec* find_encoder(const std::string& name) {
   return codec;
 }
 
+// Whether every frame the encoder writes decodes to exactly what it was given (ffv1, utvideo,
+// ffvhuff, png, ...); h264 is both lossy and lossless, so it is not one of them. Uncompressed
+// video is left to the YUV formats: Matroska, the default container, refuses it in RGB.
+bool is_lossless(const AVCodec* codec) {
+  const AVCodecDescriptor* d = avcodec_descriptor_get(codec->id);
+  return d && codec->id != AV_CODEC_ID_RAWVIDEO && (d->props & AV_CODEC_PROP_LOSSLESS) &&
+         !(d->props & AV_CODEC_PROP_LOSSY);
+}
+
 // The pixel format to encode in, in order of preference. Lossless codecs keep RGB planes exactly.
 // 4:2:0 needs even dimensions (libx264 refuses 4:2:0 at 2205 rows), so odd sizes use 4:4:4.
 // Sources deeper than 8 bits keep 10 bits where the encoder can.
@@ -62,9 +72,9 @@ AVPixelFormat choose_pixel_format(const AVCodec* codec, int width, int height, i
   const bool even = width % 2 == 0 && height % 2 == 0;
   const bool deep = bits > 8;
   std::vector<AVPixelFormat> wanted;
-  if (codec->id == AV_CODEC_ID_FFV1) {
+  if (is_lossless(codec)) {
     if (deep) wanted.insert(wanted.end(), {AV_PIX_FMT_GBRP10, AV_PIX_FMT_GBRP16});
-    wanted.insert(wanted.end(), {AV_PIX_FMT_BGR0, AV_PIX_FMT_GBRP});
+    wanted.insert(wanted.end(), {AV_PIX_FMT_BGR0, AV_PIX_FMT_GBRP, AV_PIX_FMT_RGB24});
   }
   if (deep && even) wanted.push_back(AV_PIX_FMT_YUV420P10);
   if (deep) wanted.push_back(AV_PIX_FMT_YUV444P10);
@@ -76,6 +86,16 @@ AVPixelFormat choose_pixel_format(const AVCodec* codec, int width, int height, i
       if (*p == w) return w;
   throw std::invalid_argument(
       fmt::format("--codec {}: no pixel format usable for a {}x{} frame", codec->name, width, height));
+}
+
+// Matroska holds any video FFmpeg has a Windows (BITMAPINFOHEADER) tag for, as ffmpeg itself writes
+// it (V_MS/VFW/FOURCC: utvideo, ffvhuff, png, ...), though it reports only its native codecs at
+// normal compliance.
+bool container_holds(const AVOutputFormat* format, const AVCodec* codec) {
+  if (avformat_query_codec(format, codec->id, FF_COMPLIANCE_NORMAL) == 1) return true;
+  const AVCodecTag* const windows_tags[] = {avformat_get_riff_video_tags(), nullptr};
+  return std::string_view(format->name).starts_with("matroska") && codec->type == AVMEDIA_TYPE_VIDEO &&
+         av_codec_get_tag(windows_tags, codec->id) != 0;
 }
 
 bool is_rgb(AVPixelFormat f) { return av_pix_fmt_desc_get(f)->flags & AV_PIX_FMT_FLAG_RGB; }
@@ -362,9 +382,12 @@ VideoEncoder::VideoEncoder(const std::filesystem::path& output, int width, int h
     throw std::invalid_argument(
         fmt::format("{}: unknown output format; use an extension such as .mkv, .mp4 or .mov", output.string()));
   const AVCodec* codec = find_encoder(settings.codec);
-  if (avformat_query_codec(format, codec->id, FF_COMPLIANCE_NORMAL) != 1)
-    throw std::invalid_argument(fmt::format("{}: the {} container cannot hold {} video (use .mkv)", output.string(),
-                                            format->name, codec->name));
+  if (!container_holds(format, codec))
+    throw std::invalid_argument(fmt::format("{}: the {} container cannot hold {} video ({})", output.string(),
+                                            format->name, codec->name,
+                                            container_holds(av_guess_format("matroska", nullptr, nullptr), codec)
+                                                ? "use .mkv"
+                                                : "choose another --codec"));
 
   s.temporary = temporary_path_for(output);
   AVFormatContext* raw = nullptr;

@@ -150,7 +150,7 @@ TEST(ConvertVideo, HmzT1FramePackedOutput) {
   TempDir dir;
   make_media(dir / "clip.mkv", red_blue(320, 180, false, 3));
   const auto r =
-      run_nelf("convert " + q(dir / "clip.mkv") + " " + q(dir / "out.mkv") + " --profile hmz-t1 --codec ffv1 --quiet");
+      run_nelf("convert " + q(dir / "clip.mkv") + " " + q(dir / "out.mkv") + " --profile hmz-t1 --codec utvideo --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err, "");
   const Probed p = probe(dir / "out.mkv");
@@ -203,7 +203,7 @@ TEST(ConvertVideo, SecondConversionUsesTheCachedTablesWithoutGl) {
   const std::string no_gl = "__EGL_VENDOR_LIBRARY_DIRS=" + q(dir / "none") + " ";
   const auto convert = [&](const std::string& env, const std::string& out) {
     return run_command(env + "NELF_COMPOSITE=table " + shell_quote(NELF_BINARY) + " convert " + q(dir / "clip.mkv") +
-                       " " + q(dir / out) + " --profile hmz-t1 --codec ffv1 --quiet");
+                       " " + q(dir / out) + " --profile hmz-t1 --codec utvideo --quiet");
   };
   auto r = convert(cache + no_gl, "first.mkv");
   EXPECT_EQ(r.status, 1);
@@ -265,7 +265,7 @@ TEST(ConvertVideo, EveryLayoutRoutesTheEyes) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.input);
     const auto out = dir / ("out" + std::to_string(n++) + ".mkv");
-    const auto r = run_nelf("convert " + c.input + " " + q(out) + " --codec ffv1 --profile " + q(profile));
+    const auto r = run_nelf("convert " + c.input + " " + q(out) + " --codec utvideo --profile " + q(profile));
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find(c.expect_layout), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
@@ -317,7 +317,7 @@ TEST(ConvertVideo, FramesStartAndDurationTrim) {
              "-f lavfi -i color=c=black:s=640x180:r=24:d=1 -f lavfi -i sine=frequency=440:sample_rate=48000:duration=1 "
              "-vf format=gbrp,geq=r='255*lt(T\\,0.5)':g='255*gte(T\\,0.5)':b=0 -c:a aac" +
                  h264);
-  const std::string tail = " --layout sbs --codec ffv1 --quiet --profile " + q(profile);
+  const std::string tail = " --layout sbs --codec utvideo --quiet --profile " + q(profile);
 
   auto r = run_nelf("convert " + q(dir / "clip.mkv") + " " + q(dir / "five.mkv") + " --frames 5" + tail);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -354,7 +354,7 @@ TEST(ConvertVideo, SyntheticClipWithAudio) {
   TempDir dir;
   const auto profile = small_profile(dir);
   const auto r = run_nelf("convert synthetic:duration=1,size=160x90 " + q(dir / "out.mkv") +
-                          " --codec ffv1 --quiet --profile " + q(profile));
+                          " --codec utvideo --quiet --profile " + q(profile));
   ASSERT_EQ(r.status, 0) << r.err;
   const Probed p = probe(dir / "out.mkv");
   EXPECT_EQ(p.width, 1280);
@@ -411,7 +411,7 @@ TEST(ConvertVideo, CarriesTheInputsAudioSubtitlesAndChaptersAsTheyAre) {
 TEST(ConvertVideo, BadInputs) {
   TempDir dir;
   const auto profile = small_profile(dir);
-  const std::string tail = " " + q(dir / "out.mkv") + " --quiet --codec ffv1 --profile " + q(profile);
+  const std::string tail = " " + q(dir / "out.mkv") + " --quiet --codec utvideo --profile " + q(profile);
   write_file(dir / "notes.mkv", "these are my notes, not a video\n");
   make_media(dir / "small.mkv", red_blue(320, 180, false));
   make_media(dir / "narrow.mkv", red_blue(300, 180, false));
@@ -439,7 +439,7 @@ TEST(ConvertVideo, TruncatedInputWarnsOrFailsWithStrict) {
   const std::string bytes = read_file(dir / "whole.mkv");
   write_file(dir / "cut.mkv", bytes.substr(0, bytes.size() / 2));
   std::filesystem::remove(dir / "whole.mkv");
-  const std::string tail = " --quiet --codec ffv1 --profile " + q(profile);
+  const std::string tail = " --quiet --codec utvideo --profile " + q(profile);
 
   expect_clean_failure(dir, "convert " + q(dir / "cut.mkv") + " " + q(dir / "out.mkv") + tail + " --strict", 1,
                        "cut.mkv: damaged or truncated");
@@ -545,7 +545,7 @@ TEST(ConvertVideo, OutputOntoAnInputIsRefused) {
   // Frame 2 of out_%05d.png is the input under another name.
   std::filesystem::create_hard_link(dir / "in.mkv", dir / "out_00002.png");
   const std::string in_bytes = read_file(dir / "in.mkv"), right_bytes = read_file(dir / "right.mkv");
-  const std::string tail = " --quiet --codec ffv1 --profile " + q(profile);
+  const std::string tail = " --quiet --codec utvideo --profile " + q(profile);
   const std::string same = "the output is the same file as the input";
   for (const std::string overwrite : {"", " -y"}) {
     SCOPED_TRACE(overwrite);
@@ -581,7 +581,7 @@ TEST(ConvertVideo, DanglingSymlinkOutputNeedsOverwrite) {
   make_media(dir / "in.mkv", red_blue(320, 180, false, 3));
   std::filesystem::create_symlink(dir / "missing.mkv", dir / "out.mkv");
   const std::string args =
-      "convert " + q(dir / "in.mkv") + " " + q(dir / "out.mkv") + " --quiet --codec ffv1 --profile " + q(profile);
+      "convert " + q(dir / "in.mkv") + " " + q(dir / "out.mkv") + " --quiet --codec utvideo --profile " + q(profile);
   expect_clean_failure(dir, args, 1, "out.mkv: already exists; pass -y to overwrite");
   EXPECT_TRUE(std::filesystem::is_symlink(dir / "out.mkv"));
   const auto r = run_nelf(args + " -y");
@@ -666,7 +666,7 @@ TEST(ConvertVideo, IgnoredHangupKeepsConverting) {
   TempDir dir;
   const auto profile = small_profile(dir);
   const auto r = run_command("trap '' HUP; " + std::string(NELF_BINARY) + " convert synthetic:duration=3,size=160x90 " +
-                             q(dir / "out.mkv") + " --quiet --codec ffv1 --profile " + q(profile) +
+                             q(dir / "out.mkv") + " --quiet --codec utvideo --profile " + q(profile) +
                              " & pid=$!; sleep 1; kill -HUP $pid; wait $pid; echo status $?");
   EXPECT_EQ(r.out, "status 0\n") << r.err;
   EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"out.mkv", "small.toml"}));
@@ -684,7 +684,7 @@ TEST(ConvertVideo, DiskFullLeavesNothing) {
     // 64 blocks: 32 KiB under dash (512-byte blocks), 64 KiB under bash; a frame is more than that.
     const auto r =
         run_command("ulimit -f 64; " + std::string(NELF_BINARY) + " convert synthetic:duration=1,size=320x180 " +
-                    q(dir / output) + " --quiet --codec ffv1 --profile " + q(profile));
+                    q(dir / output) + " --quiet --codec utvideo --profile " + q(profile));
     EXPECT_EQ(r.status, 1) << r.err;
     EXPECT_EQ(r.err.rfind("nelf: ", 0), 0u) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

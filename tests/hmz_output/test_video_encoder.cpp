@@ -60,24 +60,32 @@ TEST(VideoEncoder, OddHeightUses444) {
   EXPECT_EQ(probe(out, "height,pix_fmt"), "49\nyuv444p\n");
 }
 
-TEST(VideoEncoder, Ffv1IsLosslessRgb) {
-  TempDir dir;
-  const auto out = dir / "lossless.mkv";
-  EncoderSettings settings;
-  settings.codec = "ffv1";
-  VideoEncoder enc(out, 32, 20, 25, 1, settings);
-  const PackedFrame frame = test_frame(32, 20, 0.0, 8, 12);
-  enc.write_video(frame);
-  enc.finish();
-  const auto raw = dir / "raw.rgba";
-  ASSERT_EQ(run_command("ffmpeg -v error -i " + shell_quote(out.string()) + " -f rawvideo -pix_fmt rgba " +
-                        shell_quote(raw.string()))
-                .status,
-            0);
-  const std::string bytes = test::read_file(raw);
-  ASSERT_EQ(bytes.size(), frame.rgba.size());
-  EXPECT_TRUE(std::equal(bytes.begin(), bytes.end(), frame.rgba.begin(),
-                         [](char a, std::uint8_t b) { return static_cast<std::uint8_t>(a) == b; }));
+// Every lossless encoder keeps the RGB planes, in Matroska too where it holds them only under a
+// Windows tag (utvideo, ffvhuff, png): what ffmpeg itself writes and mpv plays.
+TEST(VideoEncoder, LosslessCodecsKeepRgbExactly) {
+  for (const std::string codec : {"ffv1", "utvideo", "ffvhuff", "png"}) {
+    SCOPED_TRACE(codec);
+    TempDir dir;
+    const auto out = dir / "lossless.mkv";
+    EncoderSettings settings;
+    settings.codec = codec;
+    VideoEncoder enc(out, 32, 20, 25, 1, settings);
+    EXPECT_TRUE(enc.pixel_format_name() == "bgr0" || enc.pixel_format_name() == "gbrp" ||
+                enc.pixel_format_name() == "rgb24")
+        << enc.pixel_format_name();
+    const PackedFrame frame = test_frame(32, 20, 0.0, 8, 12);
+    enc.write_video(frame);
+    enc.finish();
+    const auto raw = dir / "raw.rgba";
+    ASSERT_EQ(run_command("ffmpeg -v error -i " + shell_quote(out.string()) + " -f rawvideo -pix_fmt rgba " +
+                          shell_quote(raw.string()))
+                  .status,
+              0);
+    const std::string bytes = test::read_file(raw);
+    ASSERT_EQ(bytes.size(), frame.rgba.size());
+    EXPECT_TRUE(std::equal(bytes.begin(), bytes.end(), frame.rgba.begin(),
+                           [](char a, std::uint8_t b) { return static_cast<std::uint8_t>(a) == b; }));
+  }
 }
 
 TEST(VideoEncoder, UnfinishedLeavesNothing) {
@@ -109,9 +117,20 @@ TEST(VideoEncoder, BadSettingsAreClear) {
   bad_codec.codec = "nosuchcodec";
   EXPECT_THROW(VideoEncoder(dir / "a.mkv", 64, 64, 25, 1, bad_codec), std::invalid_argument);
   EXPECT_THROW(VideoEncoder(dir / "a.unknownext", 64, 64, 25, 1, EncoderSettings{}), std::invalid_argument);
-  EncoderSettings ffv1_in_mp4;
-  ffv1_in_mp4.codec = "ffv1";
-  EXPECT_THROW(VideoEncoder(dir / "a.mp4", 64, 64, 25, 1, ffv1_in_mp4), std::invalid_argument);
+  // What the container cannot hold says where it can go, or that no .mkv can either.
+  const auto refusal = [&](const std::string& codec, const std::string& name) -> std::string {
+    EncoderSettings settings;
+    settings.codec = codec;
+    try {
+      VideoEncoder(dir / name, 64, 64, 25, 1, settings);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_NE(refusal("ffv1", "a.mp4").find("the mp4 container cannot hold ffv1 video (use .mkv)"), std::string::npos);
+  EXPECT_NE(refusal("utvideo", "a.webm").find("cannot hold utvideo video (use .mkv)"), std::string::npos);
+  EXPECT_NE(refusal("qtrle", "a.mkv").find("cannot hold qtrle video (choose another --codec)"), std::string::npos);
   EXPECT_THROW(VideoEncoder(dir / "missing-dir" / "a.mkv", 64, 64, 25, 1, EncoderSettings{}), std::runtime_error);
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 0);
 }
