@@ -12,41 +12,37 @@
 set -euo pipefail
 cd "${1:?usage: check_layering.sh SOURCE_DIR}"
 
-level() {
-  case $1 in
-    core) echo 0 ;;
-    optics) echo 1 ;;
-    inputs | compositor | hmz_output) echo 2 ;;
-    analysis | player) echo 3 ;;
-    app) echo 4 ;;
-    packaging) echo 5 ;;
-    *) echo "" ;;
-  esac
-}
-
-bad=0 checked=0
-while IFS= read -r -d '' file; do
-  from=${file%%/*}
-  from_level=$(level "$from")
-  [ -z "$from_level" ] && continue
-  checked=$((checked + 1))
-  while IFS=: read -r line text; do
-    target=$(sed -E 's/^[[:space:]]*#[[:space:]]*include[[:space:]]*"([^"]*)".*/\1/' <<<"$text")
-    to=${target%%/*}
-    [ "$to" = "$target" ] && continue  # a file beside this one, or a generated header
-    to_level=$(level "$to")
-    [ -z "$to_level" ] && continue      # not a source folder (e.g. a third-party path)
-    if [ "$to" != "$from" ] && [ "$to_level" -ge "$from_level" ]; then
-      echo "$file:$line: $from (level $from_level) includes $target ($to, level $to_level)"
-      bad=1
-    fi
-  done < <(grep -nE '^[[:space:]]*#[[:space:]]*include[[:space:]]*"' "$file" || true)
-done < <(find core optics inputs compositor hmz_output analysis player app packaging \
-           -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' \) -print0 2>/dev/null)
-
-if [ "$checked" -eq 0 ]; then
+# One grep over the tree and one awk over its lines: a process per include took 17 s.
+files=()
+while IFS= read -r -d '' file; do files+=("$file"); done < <(
+  find core optics inputs compositor hmz_output analysis player app packaging \
+    -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' \) -print0 2>/dev/null)
+if [ "${#files[@]}" -eq 0 ]; then
   echo "check_layering: no source files found under $(pwd)" >&2
   exit 2
 fi
-[ "$bad" -eq 0 ] && echo "layering: $checked files, no include against the rule"
-exit "$bad"
+# grep -H: FILE:LINE:TEXT even for a single file.
+{ grep -HnE '^[[:space:]]*#[[:space:]]*include[[:space:]]*"' "${files[@]}" || true; } |
+  awk -v checked="${#files[@]}" '
+    BEGIN {
+      split("core:0 optics:1 inputs:2 compositor:2 hmz_output:2 analysis:3 player:3 app:4 packaging:5", pairs, " ")
+      for (i in pairs) { split(pairs[i], kv, ":"); level[kv[1]] = kv[2] }
+      bad = 0
+    }
+    {
+      file = $0; sub(/:.*/, "", file)
+      rest = substr($0, length(file) + 2); line = rest; sub(/:.*/, "", line)
+      target = rest; sub(/^[^"]*"/, "", target); sub(/".*/, "", target)
+      from = file; sub(/\/.*/, "", from)
+      to = target; sub(/\/.*/, "", to)
+      if (to == target) next                  # a file beside this one, or a generated header
+      if (!(to in level)) next                # not a source folder (e.g. a third-party path)
+      if (to != from && level[to] >= level[from]) {
+        printf "%s:%s: %s (level %d) includes %s (%s, level %d)\n", file, line, from, level[from], target, to, level[to]
+        bad = 1
+      }
+    }
+    END {
+      if (!bad) printf "layering: %d files, no include against the rule\n", checked
+      exit bad
+    }'
