@@ -15,16 +15,20 @@ fail() {
   failures=$((failures + 1))
 }
 
-# The subcommands and options, as nelf's own help prints them.
-commands=$("$nelf" --help | awk '/^Subcommands:/ {on = 1; next} on && /^  [a-z]/ {print $1}')
+# The subcommands and options, as nelf's own help prints them; each help text is asked once (every
+# check below reads it again, and nelf takes a tenth of a second to start).
+declare -A help_text
+help_text[_]=$("$nelf" --help)
+commands=$(awk '/^Subcommands:/ {on = 1; next} on && /^  [a-z]/ {print $1}' <<<"${help_text[_]}")
 [ -n "$commands" ] || { echo "FAIL: no subcommands in nelf --help" >&2; exit 1; }
+for c in $commands; do help_text[$c]=$("$nelf" "$c" --help); done
 # Options of one help text: the "-y,--overwrite TEXT ..." column of each "  -..." line.
 help_options() {
-  "$nelf" "$@" --help | awk '/^  -/ {n = split($1, names, ","); for (i = 1; i <= n; i++) print names[i]}' | sort -u
+  awk '/^  -/ {n = split($1, names, ","); for (i = 1; i <= n; i++) print names[i]}' <<<"${help_text[${1:-_}]}" | sort -u
 }
 # Positionals of one help text: the names in the "Positionals:" section.
 help_positionals() {
-  "$nelf" "$@" --help | awk '/^[A-Za-z].*:$/ {on = ($0 == "Positionals:"); next} on && /^  [a-z]/ {print $1}'
+  awk '/^[A-Za-z].*:$/ {on = ($0 == "Positionals:"); next} on && /^  [a-z]/ {print $1}' <<<"${help_text[$1]}"
 }
 same_set() {  # same_set WHAT EXPECTED ACTUAL
   local missing extra
