@@ -62,7 +62,7 @@ TEST(CliContract, MissingGpuIsReportedWhetherOrNotTheTablesAreCached) {
   const std::string env = "NELF_CACHE_DIR=" + q(cache.path()) + " NELF_COMPOSITE=table ";
   const auto convert = [&](const std::string& extra) {
     return run_command(env + shell_quote(NELF_BINARY) + " convert " + q(clip) + " " + q(dir / "out.mkv") +
-                       " --profile hmz-t1 --layout mono --codec ffv1 --quiet" + extra);
+                       " --profile hmz-t1 --layout mono --codec utvideo --quiet" + extra);
   };
   const auto uncached = convert(" --gpu 99");
   EXPECT_EQ(uncached.status, 1);
@@ -80,7 +80,7 @@ TEST(CliContract, MissingGpuIsReportedWhetherOrNotTheTablesAreCached) {
   EXPECT_FALSE(std::filesystem::exists(dir / "out.mkv"));
   const auto from_environment =
       run_command("NELF_GPU=99 " + env + shell_quote(NELF_BINARY) + " convert " + q(clip) + " " + q(dir / "out.mkv") +
-                  " --profile hmz-t1 --layout mono --codec ffv1 --quiet");
+                  " --profile hmz-t1 --layout mono --codec utvideo --quiet");
   EXPECT_EQ(from_environment.status, uncached.status);
   EXPECT_EQ(from_environment.err, uncached.err);
   EXPECT_FALSE(std::filesystem::exists(dir / "out.mkv"));

@@ -82,7 +82,7 @@ TEST(ClosedPipe, ConversionOutlivesAClosedStderr) {
   TempDir dir;
   const auto profile = write_small_profile(dir);
   const auto r = run_into_closed_pipe(std::string(NELF_BINARY) + " convert synthetic:duration=3,size=320x180 " +
-                                          q(dir / "out.mkv") + " --codec ffv1 --no-audio --profile " + q(profile),
+                                          q(dir / "out.mkv") + " --codec utvideo --no-audio --profile " + q(profile),
                                       2);
   EXPECT_FALSE(r.signalled) << "killed by signal " << r.status;
   EXPECT_EQ(r.status, 0);
