@@ -24,6 +24,7 @@
 
 #include "core/printable.hpp"
 #include "core/user_error.hpp"
+#include "inputs/pipewire_frame.hpp"
 #include "inputs/screencast_portal.hpp"
 
 namespace nelf {
@@ -65,33 +66,6 @@ std::string describe(unsigned id, const NodeInfo& node) {
   const std::string& label = node.description.empty() ? node.name : node.description;
   return fmt::format("{} \"{}\"{}", id, printable(label),
                      node.media_class.empty() ? "" : fmt::format(" ({})", node.media_class));
-}
-
-// Bytes a pixel of the 8-bit RGB orders nelf reads, and where R, G and B sit in it.
-struct PixelOrder {
-  int bytes = 0, r = 0, g = 0, b = 0;
-};
-std::optional<PixelOrder> pixel_order(spa_video_format format) {
-  switch (format) {
-    case SPA_VIDEO_FORMAT_RGBA:
-    case SPA_VIDEO_FORMAT_RGBx:
-      return PixelOrder{4, 0, 1, 2};
-    case SPA_VIDEO_FORMAT_BGRA:
-    case SPA_VIDEO_FORMAT_BGRx:
-      return PixelOrder{4, 2, 1, 0};
-    case SPA_VIDEO_FORMAT_xRGB:
-    case SPA_VIDEO_FORMAT_ARGB:
-      return PixelOrder{4, 1, 2, 3};
-    case SPA_VIDEO_FORMAT_xBGR:
-    case SPA_VIDEO_FORMAT_ABGR:
-      return PixelOrder{4, 3, 2, 1};
-    case SPA_VIDEO_FORMAT_RGB:
-      return PixelOrder{3, 0, 1, 2};
-    case SPA_VIDEO_FORMAT_BGR:
-      return PixelOrder{3, 2, 1, 0};
-    default:
-      return std::nullopt;
-  }
 }
 
 }  // namespace
@@ -166,8 +140,8 @@ struct PipeWireCapture::State {
   bool synced = false;
   unsigned target = 0;
   spa_video_info_raw format{};
-  std::optional<PixelOrder> order;
-  std::string failure;  // why the stream cannot go on (a link or daemon error)
+  std::optional<PipeWireFrameReader> reader;  // for `format`, once negotiated
+  std::string failure;                        // why the stream cannot go on (a link or daemon error)
 
   // Under `mutex`: the newest frame, for the reading thread.
   std::mutex mutex;
@@ -230,10 +204,8 @@ struct PipeWireCapture::State {
   static void on_link_info(void* data, const pw_link_info* info) {
     auto* s = static_cast<State*>(data);
     if (info->state == PW_LINK_STATE_ERROR)
-      s->end(
-          fmt::format("the link to the node failed ({}); nelf reads 8-bit RGB frames (BGRx, RGBx, BGRA, RGBA, "
-                      "RGB, BGR) in shared memory",
-                      info->error ? info->error : "no reason given"));
+      s->end(fmt::format("the link to the node failed ({}); nelf reads {} in shared memory",
+                         info->error ? info->error : "no reason given", PipeWireFrameReader::kFormatsRead));
   }
   static void on_param_changed(void* data, uint32_t id, const spa_pod* param) {
     auto* s = static_cast<State*>(data);
@@ -244,7 +216,7 @@ struct PipeWireCapture::State {
       return;
     s->format = {};
     if (spa_format_video_raw_parse(param, &s->format) < 0) return;
-    s->order = pixel_order(s->format.format);
+    s->reader.emplace(s->format);
     // Buffers nelf can read with the CPU: shared memory, mapped (DMA-BUF import is not done yet).
     std::uint8_t bytes[256];
     spa_pod_builder b = SPA_POD_BUILDER_INIT(bytes, sizeof bytes);
@@ -290,37 +262,16 @@ struct PipeWireCapture::State {
 
   // The frame in `buffer` as RGBA, when it holds one and the rate allows.
   void keep(const spa_buffer& buffer) {
-    if (!order || buffer.n_datas < 1) return;
-    const spa_data& d = buffer.datas[0];
-    if (!d.data || !d.chunk || d.chunk->size == 0 || (d.chunk->flags & SPA_CHUNK_FLAG_CORRUPTED)) return;
+    if (!reader || !reader->readable()) return;
     const auto now = Clock::now();
     if (now - last_kept < std::chrono::duration<double>(0.9 / spec.fps)) return;
-    const int w = static_cast<int>(format.size.width), h = static_cast<int>(format.size.height);
-    const std::size_t row = static_cast<std::size_t>(w) * static_cast<std::size_t>(order->bytes);
-    const std::size_t stride = d.chunk->stride > 0 ? static_cast<std::size_t>(d.chunk->stride) : row;
-    const std::size_t offset = d.chunk->offset % std::max<std::uint32_t>(d.maxsize, 1);
-    if (w <= 0 || h <= 0 || stride < row || offset + stride * static_cast<std::size_t>(h - 1) + row > d.maxsize) return;
-    CapturedImage image;
-    image.width = w;
-    image.height = h;
-    image.rgba.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4);
-    const auto* base = static_cast<const std::uint8_t*>(d.data) + offset;
-    const PixelOrder o = *order;
-    for (int y = 0; y < h; ++y) {
-      const std::uint8_t* src = base + static_cast<std::size_t>(y) * stride;
-      std::uint8_t* dst = image.rgba.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(w) * 4;
-      for (int x = 0; x < w; ++x, src += o.bytes, dst += 4) {
-        dst[0] = src[o.r];
-        dst[1] = src[o.g];
-        dst[2] = src[o.b];
-        dst[3] = 255;
-      }
-    }
-    image.captured_at = Clock::now();
+    std::optional<CapturedImage> converted = reader->read(buffer);
+    if (!converted) return;
+    converted->captured_at = Clock::now();
     last_kept = now;
     {
       const std::lock_guard lock(mutex);
-      latest = std::move(image);
+      latest = std::move(converted);
     }
     changed.notify_all();
   }
@@ -476,9 +427,13 @@ PipeWireCapture::PipeWireCapture(const PipeWireCaptureSpec& spec, std::string in
   const auto* formats = static_cast<const spa_pod*>(spa_pod_builder_add_object(
       &b, SPA_TYPE_OBJECT_Format, SPA_PARAM_EnumFormat, SPA_FORMAT_mediaType, SPA_POD_Id(SPA_MEDIA_TYPE_video),
       SPA_FORMAT_mediaSubtype, SPA_POD_Id(SPA_MEDIA_SUBTYPE_raw), SPA_FORMAT_VIDEO_format,
-      SPA_POD_CHOICE_ENUM_Id(11, SPA_VIDEO_FORMAT_BGRx, SPA_VIDEO_FORMAT_BGRx, SPA_VIDEO_FORMAT_BGRA,
+      // RGB first (a desktop's own order, nothing to convert), then the YUV formats.
+      SPA_POD_CHOICE_ENUM_Id(20, SPA_VIDEO_FORMAT_BGRx, SPA_VIDEO_FORMAT_BGRx, SPA_VIDEO_FORMAT_BGRA,
                              SPA_VIDEO_FORMAT_RGBx, SPA_VIDEO_FORMAT_RGBA, SPA_VIDEO_FORMAT_xRGB, SPA_VIDEO_FORMAT_ARGB,
-                             SPA_VIDEO_FORMAT_xBGR, SPA_VIDEO_FORMAT_ABGR, SPA_VIDEO_FORMAT_RGB, SPA_VIDEO_FORMAT_BGR),
+                             SPA_VIDEO_FORMAT_xBGR, SPA_VIDEO_FORMAT_ABGR, SPA_VIDEO_FORMAT_RGB, SPA_VIDEO_FORMAT_BGR,
+                             SPA_VIDEO_FORMAT_I420, SPA_VIDEO_FORMAT_YV12, SPA_VIDEO_FORMAT_NV12, SPA_VIDEO_FORMAT_NV21,
+                             SPA_VIDEO_FORMAT_YUY2, SPA_VIDEO_FORMAT_UYVY, SPA_VIDEO_FORMAT_YVYU, SPA_VIDEO_FORMAT_Y42B,
+                             SPA_VIDEO_FORMAT_Y444),  // the formats PipeWireFrameReader reads
       SPA_FORMAT_VIDEO_size, SPA_POD_CHOICE_RANGE_Rectangle(&size_default, &size_min, &size_max),
       SPA_FORMAT_VIDEO_framerate, SPA_POD_CHOICE_RANGE_Fraction(&rate_default, &rate_min, &rate_max)));
 #pragma GCC diagnostic pop
@@ -501,9 +456,10 @@ CapturedImage PipeWireCapture::read() {
   pw_thread_loop_lock(s.loop.get());
   std::string why = s.failure;
   const bool negotiated = s.format.size.width > 0;
-  const bool readable = s.order.has_value();
+  const bool readable = s.reader && s.reader->readable();
   pw_thread_loop_unlock(s.loop.get());
-  if (why.empty() && negotiated && !readable) why = "it sends a pixel format nelf does not read (8-bit RGB only)";
+  if (why.empty() && negotiated && !readable)
+    why = "it sends a pixel format nelf does not read (8-bit RGB or YUV only)";
   if (why.empty() && !negotiated && s.portal)
     why =
         "nothing linked nelf to the cast's node in 10 s (the desktop's session manager does: is WirePlumber or "

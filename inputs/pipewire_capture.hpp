@@ -4,8 +4,8 @@
 // named directly (gamescope's, anything `pw-cli ls Node` lists as Video/Source). A named node is
 // linked by nelf itself, so no session manager is needed and none links nelf to anything else; the
 // portal's stream is linked by the desktop's session manager, as the portal's connection sees only
-// that node. Frames come in shared memory (MemFd or MemPtr buffers) in any 8-bit RGB order and are
-// read as RGBA.
+// that node. Frames come in shared memory (MemFd or MemPtr buffers) in any 8-bit RGB order or in
+// 8-bit YUV and are read as RGBA (inputs/pipewire_frame).
 #include <atomic>
 #include <chrono>
 #include <memory>

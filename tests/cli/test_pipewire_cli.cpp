@@ -157,6 +157,39 @@ TEST_F(PipeWireCliTest, ANodesFramesAreWhatTheSameStillWouldShow) {
   }
 }
 
+TEST_F(PipeWireCliTest, YuvNodesAreWhatFfmpegMakesOfTheSameFrame) {
+  // Cameras, capture cards and encoders' casts send YUV: nelf converts it (swscale) as ffmpeg
+  // converts the same raw frame, so the recording is nelf's conversion of ffmpeg's picture of it.
+  // I420 (one plane a spa_data, as GStreamer sends it) and YUY2 (packed); the other formats and
+  // layouts in tests/inputs/test_pipewire_frame.cpp.
+  const std::string small = " --signal sbs --profile " + test::shell_quote(test::write_small_profile(dir_).string());
+  for (const auto& [format, ffmpeg_format] : {std::pair{"I420", "yuv420p"}, {"YUY2", "yuyv422"}}) {
+    SCOPED_TRACE(format);
+    const auto raw = dir_ / "bars.yuv", picture = dir_ / "bars.png", reference = dir_ / "reference.png";
+    const auto made = test::run_command(fmt::format(
+        "gst-launch-1.0 -q videotestsrc num-buffers=1 pattern=smpte ! video/x-raw,format={},width=640,height=180 ! "
+        "filesink location={} && ffmpeg -v error -f rawvideo -pix_fmt {} -s 640x180 -i {} "
+        "-sws_flags bicubic+accurate_rnd+full_chroma_int -pix_fmt rgb24 -y {}",
+        format, test::shell_quote(raw.string()), ffmpeg_format, test::shell_quote(raw.string()),
+        test::shell_quote(picture.string())));
+    ASSERT_EQ(made.status, 0) << made.err;
+    ASSERT_EQ(test::run_nelf("convert " + test::shell_quote(picture.string()) + " -y " +
+                             test::shell_quote(reference.string()) + small)
+                  .status,
+              0);
+    const std::string name = std::string("yuv-") + format;
+    start_node(name, format);
+    const auto out = dir_ / (name + ".png");
+    const auto r =
+        test::run_nelf("convert pipewire:node=" + name + " " + test::shell_quote(out.string()) + " --frames 1" + small);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto got = test::read_back(out), expected = test::read_back(reference);
+    ASSERT_EQ(got.width, expected.width);
+    ASSERT_EQ(got.height, expected.height);
+    EXPECT_EQ(differing_channels(got, expected), 0u);
+  }
+}
+
 TEST_F(PipeWireCliTest, ARecordingEndsCompleteWhenTheNodeGoesAway) {
   // As a game's window closing ends `x11:window=`: the producer quits, nelf finishes the file.
   start_node("leaving", "BGRx");
@@ -196,8 +229,8 @@ TEST_F(PipeWireCliTest, BadNodesAreOneLine) {
   test::expect_clean_failure(dir_, "convert pipewire:node=bars out.mkv --frames 1 --layout alt", 2,
                              "layout alt needs a file");
   test::expect_clean_failure(dir_, "probe pipewire:node=bars", 2, "probe describes media files");
-  start_node("yuv", "I420");
-  test::expect_clean_failure(dir_, "convert pipewire:node=yuv out.mkv --frames 1", 1,
+  start_node("grey", "GRAY8");
+  test::expect_clean_failure(dir_, "convert pipewire:node=grey out.mkv --frames 1", 1,
                              "the link to the node failed (no more input formats); nelf reads 8-bit RGB frames");
   {
     const test::TempDir nowhere;
