@@ -383,11 +383,9 @@ VideoEncoder::VideoEncoder(const std::filesystem::path& output, int width, int h
         fmt::format("{}: unknown output format; use an extension such as .mkv, .mp4 or .mov", output.string()));
   const AVCodec* codec = find_encoder(settings.codec);
   if (!container_holds(format, codec))
-    throw std::invalid_argument(fmt::format("{}: the {} container cannot hold {} video ({})", output.string(),
-                                            format->name, codec->name,
-                                            container_holds(av_guess_format("matroska", nullptr, nullptr), codec)
-                                                ? "use .mkv"
-                                                : "choose another --codec"));
+    throw std::invalid_argument(fmt::format(
+        "{}: the {} container cannot hold {} video ({})", output.string(), format->name, codec->name,
+        container_holds(av_guess_format("matroska", nullptr, nullptr), codec) ? "use .mkv" : "choose another --codec"));
 
   s.temporary = temporary_path_for(output);
   AVFormatContext* raw = nullptr;
