@@ -13,7 +13,11 @@
 //
 // The game's view of the default framebuffer is kept: binding framebuffer 0 binds the current eye's
 // object, and the bindings, draw and read buffers it queries are what it set. Drawing with GL_BACK
-// (both eyes) clears both eyes; other drawing with GL_BACK goes to the left eye only.
+// (both eyes, as a game draws its HUD or clears) is done into each eye: every draw call, clear and
+// blit is made twice, once a framebuffer, and immediate mode (glBegin … glEnd) is recorded into a
+// display list and that called twice. What a display list, glBitmap or glBegin … glEnd change (the
+// current colour, the raster position, matrices) is put back between the two, so that the game's
+// state afterwards is that of one call.
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/gl.h>
 #include <GL/glext.h>
@@ -32,6 +36,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -234,6 +239,9 @@ struct Eyes {
   int width = 0, height = 0;
   GLenum draw_buffer = GL_BACK, read_buffer = GL_BACK;  // as the game set them on "framebuffer 0"
   GLuint game_draw_fbo = 0, game_read_fbo = 0;          // the game's own framebuffer objects, 0: ours
+  bool compiling_list = false;  // between the game's glNewList and glEndList: drawing is recorded
+  GLuint immediate_list = 0;    // glBegin … glEnd into both eyes: recorded here, then called twice
+  bool recording_immediate = false;
   std::uint64_t swaps = 0;
   NelfLink link;
 };
@@ -417,6 +425,72 @@ void show_left_eye(const Eyes& e) {
   if (scissor) real_glEnable(GL_SCISSOR_TEST);
 }
 
+// Whether drawing now goes into both eyes: GL_BACK (or another name of both) on "framebuffer 0" of
+// a context whose eyes have their own framebuffers, and not into a display list being compiled
+// (that drawing is recorded, and made into both eyes when the list is called), nor between glBegin
+// and glEnd (a list called there is recorded with the vertices).
+Eyes* drawing_both_eyes() {
+  Eyes* e = t_current;
+  return e && e->active && e->game_draw_fbo == 0 && !e->compiling_list && !e->recording_immediate &&
+                 is_both(e->draw_buffer)
+             ? e
+             : nullptr;
+}
+
+// The state a display list, glBitmap or immediate mode may change, kept over the first eye's
+// drawing and put back before the second: the attribute groups (current colour, raster position,
+// enables, …) and the three matrices. Compatibility contexts only, where those calls exist.
+class KeptState {
+ public:
+  KeptState() {
+    NELF_REAL_GL(glGetIntegerv);
+    NELF_REAL_GL(glGetFloatv);
+    NELF_REAL_GL(glPushAttrib);
+    GLint depth = 0, most = 0;
+    real_glGetIntegerv(GL_ATTRIB_STACK_DEPTH, &depth);
+    real_glGetIntegerv(GL_MAX_ATTRIB_STACK_DEPTH, &most);
+    pushed_ = depth < most;
+    if (pushed_) real_glPushAttrib(GL_ALL_ATTRIB_BITS);
+    real_glGetIntegerv(GL_MATRIX_MODE, &mode_);
+    real_glGetFloatv(GL_MODELVIEW_MATRIX, matrices_[0]);
+    real_glGetFloatv(GL_PROJECTION_MATRIX, matrices_[1]);
+    real_glGetFloatv(GL_TEXTURE_MATRIX, matrices_[2]);
+  }
+  void put_back() const {
+    NELF_REAL_GL(glPopAttrib);
+    NELF_REAL_GL(glMatrixMode);
+    NELF_REAL_GL(glLoadMatrixf);
+    if (pushed_) real_glPopAttrib();
+    const GLenum modes[3] = {GL_MODELVIEW, GL_PROJECTION, GL_TEXTURE};
+    for (int i = 0; i < 3; ++i) {
+      real_glMatrixMode(modes[i]);
+      real_glLoadMatrixf(matrices_[i]);
+    }
+    real_glMatrixMode(static_cast<GLenum>(mode_));
+  }
+
+ private:
+  bool pushed_ = false;
+  GLint mode_ = GL_MODELVIEW;
+  GLfloat matrices_[3][16] = {};
+};
+
+// Makes `draw` into the right eye, then into the left, when drawing goes into both; once otherwise.
+// `keep_state`: for calls that change state (display lists, glBitmap, immediate mode).
+template <typename Draw>
+void into_eyes(Draw draw, bool keep_state = false) {
+  NELF_REAL_GL(glBindFramebuffer);
+  const Eyes* e = drawing_both_eyes();
+  if (!e) return draw();
+  std::optional<KeptState> kept;
+  if (keep_state) kept.emplace();
+  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e->fbo[1]);
+  draw();
+  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e->fbo[0]);
+  if (kept) kept->put_back();
+  draw();
+}
+
 // glXChooseVisual's list: GLX_STEREO (a flag without a value) removed.
 std::vector<int> without_stereo_flag(const int* attributes) {
   std::vector<int> out;
@@ -594,16 +668,110 @@ __attribute__((visibility("default"))) void glGetBooleanv(GLenum name, GLboolean
   if (name == GL_STEREO && t_current) *data = GL_TRUE;
 }
 
-// A clear of both back buffers (GL_BACK on a stereo framebuffer) clears both eyes.
-__attribute__((visibility("default"))) void glClear(GLbitfield mask) {
-  NELF_REAL_GL(glClear);
-  NELF_REAL_GL(glBindFramebuffer);
+// Drawing into both back buffers (GL_BACK on a stereo framebuffer) draws into both eyes: each call
+// below is made into each eye's framebuffer (into_eyes).
+#define NELF_INTO_EYES(name, parameters, arguments)             \
+  __attribute__((visibility("default"))) void name parameters { \
+    NELF_REAL_GL(name);                                         \
+    into_eyes([&] { real_##name arguments; });                  \
+  }
+NELF_INTO_EYES(glClear, (GLbitfield mask), (mask))
+NELF_INTO_EYES(glClearBufferfv, (GLenum buffer, GLint drawbuffer, const GLfloat* value), (buffer, drawbuffer, value))
+NELF_INTO_EYES(glClearBufferiv, (GLenum buffer, GLint drawbuffer, const GLint* value), (buffer, drawbuffer, value))
+NELF_INTO_EYES(glClearBufferuiv, (GLenum buffer, GLint drawbuffer, const GLuint* value), (buffer, drawbuffer, value))
+NELF_INTO_EYES(glClearBufferfi, (GLenum buffer, GLint drawbuffer, GLfloat depth, GLint stencil),
+               (buffer, drawbuffer, depth, stencil))
+NELF_INTO_EYES(glDrawArrays, (GLenum mode, GLint first, GLsizei count), (mode, first, count))
+NELF_INTO_EYES(glDrawElements, (GLenum mode, GLsizei count, GLenum type, const void* indices),
+               (mode, count, type, indices))
+NELF_INTO_EYES(glDrawRangeElements,
+               (GLenum mode, GLuint start, GLuint end, GLsizei count, GLenum type, const void* indices),
+               (mode, start, end, count, type, indices))
+NELF_INTO_EYES(glDrawArraysInstanced, (GLenum mode, GLint first, GLsizei count, GLsizei instances),
+               (mode, first, count, instances))
+NELF_INTO_EYES(glDrawElementsInstanced,
+               (GLenum mode, GLsizei count, GLenum type, const void* indices, GLsizei instances),
+               (mode, count, type, indices, instances))
+NELF_INTO_EYES(glDrawElementsBaseVertex, (GLenum mode, GLsizei count, GLenum type, const void* indices, GLint base),
+               (mode, count, type, indices, base))
+NELF_INTO_EYES(glDrawRangeElementsBaseVertex,
+               (GLenum mode, GLuint start, GLuint end, GLsizei count, GLenum type, const void* indices, GLint base),
+               (mode, start, end, count, type, indices, base))
+NELF_INTO_EYES(glDrawElementsInstancedBaseVertex,
+               (GLenum mode, GLsizei count, GLenum type, const void* indices, GLsizei instances, GLint base),
+               (mode, count, type, indices, instances, base))
+NELF_INTO_EYES(glMultiDrawArrays, (GLenum mode, const GLint* first, const GLsizei* count, GLsizei n),
+               (mode, first, count, n))
+NELF_INTO_EYES(glMultiDrawElements,
+               (GLenum mode, const GLsizei* count, GLenum type, const void* const* indices, GLsizei n),
+               (mode, count, type, indices, n))
+NELF_INTO_EYES(glDrawArraysIndirect, (GLenum mode, const void* indirect), (mode, indirect))
+NELF_INTO_EYES(glDrawElementsIndirect, (GLenum mode, GLenum type, const void* indirect), (mode, type, indirect))
+NELF_INTO_EYES(glBlitFramebuffer,
+               (GLint sx0, GLint sy0, GLint sx1, GLint sy1, GLint dx0, GLint dy0, GLint dx1, GLint dy1, GLbitfield mask,
+                GLenum filter),
+               (sx0, sy0, sx1, sy1, dx0, dy0, dx1, dy1, mask, filter))
+NELF_INTO_EYES(glDrawPixels, (GLsizei width, GLsizei height, GLenum format, GLenum type, const void* pixels),
+               (width, height, format, type, pixels))
+NELF_INTO_EYES(glRectf, (GLfloat x1, GLfloat y1, GLfloat x2, GLfloat y2), (x1, y1, x2, y2))
+NELF_INTO_EYES(glRectd, (GLdouble x1, GLdouble y1, GLdouble x2, GLdouble y2), (x1, y1, x2, y2))
+NELF_INTO_EYES(glRecti, (GLint x1, GLint y1, GLint x2, GLint y2), (x1, y1, x2, y2))
+NELF_INTO_EYES(glRects, (GLshort x1, GLshort y1, GLshort x2, GLshort y2), (x1, y1, x2, y2))
+#undef NELF_INTO_EYES
+
+// These change state (a list may set the colour or a matrix; glBitmap moves the raster position):
+// it is put back between the eyes.
+__attribute__((visibility("default"))) void glCallList(GLuint list) {
+  NELF_REAL_GL(glCallList);
+  into_eyes([&] { real_glCallList(list); }, true);
+}
+__attribute__((visibility("default"))) void glCallLists(GLsizei n, GLenum type, const void* lists) {
+  NELF_REAL_GL(glCallLists);
+  into_eyes([&] { real_glCallLists(n, type, lists); }, true);
+}
+__attribute__((visibility("default"))) void glBitmap(GLsizei width, GLsizei height, GLfloat x, GLfloat y,
+                                                     GLfloat move_x, GLfloat move_y, const GLubyte* bitmap) {
+  NELF_REAL_GL(glBitmap);
+  into_eyes([&] { real_glBitmap(width, height, x, y, move_x, move_y, bitmap); }, true);
+}
+
+// Drawing recorded into the game's own display list is made into both eyes when the list is called.
+__attribute__((visibility("default"))) void glNewList(GLuint list, GLenum mode) {
+  NELF_REAL_GL(glNewList);
+  if (Eyes* e = t_current) e->compiling_list = true;
+  real_glNewList(list, mode);
+}
+__attribute__((visibility("default"))) void glEndList() {
+  NELF_REAL_GL(glEndList);
+  if (Eyes* e = t_current) e->compiling_list = false;
+  real_glEndList();
+}
+
+// Immediate mode into both eyes: the vertices between glBegin and glEnd are recorded into a list of
+// the interposer's, which is then called into each eye.
+__attribute__((visibility("default"))) void glBegin(GLenum mode) {
+  NELF_REAL_GL(glBegin);
+  NELF_REAL_GL(glGenLists);
+  NELF_REAL_GL(glNewList);
+  if (Eyes* e = drawing_both_eyes()) {
+    if (!e->immediate_list) e->immediate_list = real_glGenLists(1);
+    if (e->immediate_list) {
+      real_glNewList(e->immediate_list, GL_COMPILE);
+      e->recording_immediate = true;
+    }
+  }
+  real_glBegin(mode);
+}
+__attribute__((visibility("default"))) void glEnd() {
+  NELF_REAL_GL(glEnd);
+  NELF_REAL_GL(glEndList);
+  NELF_REAL_GL(glCallList);
+  real_glEnd();
   Eyes* e = t_current;
-  if (!e || !e->active || e->game_draw_fbo != 0 || !is_both(e->draw_buffer)) return real_glClear(mask);
-  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e->fbo[1]);
-  real_glClear(mask);
-  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e->fbo[0]);
-  real_glClear(mask);
+  if (!e || !e->recording_immediate) return;
+  e->recording_immediate = false;
+  real_glEndList();
+  into_eyes([&] { real_glCallList(e->immediate_list); }, true);
 }
 
 __GLXextFuncPtr glXGetProcAddressARB(const GLubyte* name);
@@ -644,6 +812,44 @@ void* interposed(const char* name) {
       {"glGetIntegerv", reinterpret_cast<void*>(&glGetIntegerv)},
       {"glGetBooleanv", reinterpret_cast<void*>(&glGetBooleanv)},
       {"glClear", reinterpret_cast<void*>(&glClear)},
+      {"glClearBufferfv", reinterpret_cast<void*>(&glClearBufferfv)},
+      {"glClearBufferiv", reinterpret_cast<void*>(&glClearBufferiv)},
+      {"glClearBufferuiv", reinterpret_cast<void*>(&glClearBufferuiv)},
+      {"glClearBufferfi", reinterpret_cast<void*>(&glClearBufferfi)},
+      {"glDrawArrays", reinterpret_cast<void*>(&glDrawArrays)},
+      {"glDrawArraysEXT", reinterpret_cast<void*>(&glDrawArrays)},
+      {"glDrawElements", reinterpret_cast<void*>(&glDrawElements)},
+      {"glDrawRangeElements", reinterpret_cast<void*>(&glDrawRangeElements)},
+      {"glDrawRangeElementsEXT", reinterpret_cast<void*>(&glDrawRangeElements)},
+      {"glDrawArraysInstanced", reinterpret_cast<void*>(&glDrawArraysInstanced)},
+      {"glDrawArraysInstancedARB", reinterpret_cast<void*>(&glDrawArraysInstanced)},
+      {"glDrawArraysInstancedEXT", reinterpret_cast<void*>(&glDrawArraysInstanced)},
+      {"glDrawElementsInstanced", reinterpret_cast<void*>(&glDrawElementsInstanced)},
+      {"glDrawElementsInstancedARB", reinterpret_cast<void*>(&glDrawElementsInstanced)},
+      {"glDrawElementsInstancedEXT", reinterpret_cast<void*>(&glDrawElementsInstanced)},
+      {"glDrawElementsBaseVertex", reinterpret_cast<void*>(&glDrawElementsBaseVertex)},
+      {"glDrawRangeElementsBaseVertex", reinterpret_cast<void*>(&glDrawRangeElementsBaseVertex)},
+      {"glDrawElementsInstancedBaseVertex", reinterpret_cast<void*>(&glDrawElementsInstancedBaseVertex)},
+      {"glMultiDrawArrays", reinterpret_cast<void*>(&glMultiDrawArrays)},
+      {"glMultiDrawArraysEXT", reinterpret_cast<void*>(&glMultiDrawArrays)},
+      {"glMultiDrawElements", reinterpret_cast<void*>(&glMultiDrawElements)},
+      {"glMultiDrawElementsEXT", reinterpret_cast<void*>(&glMultiDrawElements)},
+      {"glDrawArraysIndirect", reinterpret_cast<void*>(&glDrawArraysIndirect)},
+      {"glDrawElementsIndirect", reinterpret_cast<void*>(&glDrawElementsIndirect)},
+      {"glBlitFramebuffer", reinterpret_cast<void*>(&glBlitFramebuffer)},
+      {"glBlitFramebufferEXT", reinterpret_cast<void*>(&glBlitFramebuffer)},
+      {"glDrawPixels", reinterpret_cast<void*>(&glDrawPixels)},
+      {"glRectf", reinterpret_cast<void*>(&glRectf)},
+      {"glRectd", reinterpret_cast<void*>(&glRectd)},
+      {"glRecti", reinterpret_cast<void*>(&glRecti)},
+      {"glRects", reinterpret_cast<void*>(&glRects)},
+      {"glCallList", reinterpret_cast<void*>(&glCallList)},
+      {"glCallLists", reinterpret_cast<void*>(&glCallLists)},
+      {"glBitmap", reinterpret_cast<void*>(&glBitmap)},
+      {"glNewList", reinterpret_cast<void*>(&glNewList)},
+      {"glEndList", reinterpret_cast<void*>(&glEndList)},
+      {"glBegin", reinterpret_cast<void*>(&glBegin)},
+      {"glEnd", reinterpret_cast<void*>(&glEnd)},
   };
   if (!name || name[0] != 'g' || name[1] != 'l') return nullptr;
   for (const Entry& entry : table)

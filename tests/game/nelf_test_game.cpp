@@ -7,6 +7,7 @@
 //   nelf-test-game [--toolkit glfw|sdl2] [--mode sbs|sbs-half|tab|tab-half|fp|quad-buffer]
 //                  [--fps N] [--size WxH] [--frames N] [--duration S] [--title T] [--log FILE]
 //                  [--reopen-after N] [--exit-status N] [--scene bars|planes]
+//                  [--hud arrays|immediate|list|bitmap]
 //
 // --size is one eye's size (default 1280x720); the window is sized from it and the mode (fp: the
 // frame-packed window of that eye size, 1280x720 → 1280x1470). The game follows its window's size
@@ -16,7 +17,9 @@
 // one, as games do for a splash screen or a new video mode; --exit-status N is the status it ends
 // with (after --frames or --duration), for the tests of `nelf run`. --scene planes draws, instead of
 // the flat bars, two textured planes in perspective with a depth buffer, as a 3D game does
-// (planes_scene.hpp), for the tests of the game's depth.
+// (planes_scene.hpp), for the tests of the game's depth. --hud (quad-buffer only) draws a HUD over
+// both eyes at once with glDrawBuffer(GL_BACK), with glDrawArrays, glBegin/glEnd, a display list or
+// glBitmap (hud.hpp).
 // epoxy before the toolkits' headers, which would include GL/gl.h.
 #include <epoxy/gl.h>
 
@@ -39,6 +42,7 @@
 #include <vector>
 
 #include "core/frame_stamp.hpp"
+#include "game/hud.hpp"
 #include "game/planes_scene.hpp"
 
 namespace {
@@ -48,6 +52,7 @@ extern "C" void on_signal(int) { g_stop = true; }
 
 enum class Toolkit { glfw, sdl2 };
 enum class Mode { sbs, sbs_half, tab, tab_half, fp, quad_buffer };
+enum class Hud { none, arrays, immediate, list, bitmap };
 
 struct Options {
   Toolkit toolkit = Toolkit::glfw;
@@ -62,6 +67,7 @@ struct Options {
   long reopen_after = 0;  // 0: never
   int exit_status = 0;
   bool planes = false;  // --scene planes
+  Hud hud = Hud::none;
 };
 
 class BadUsage : public std::runtime_error {
@@ -131,6 +137,18 @@ Options parse(int argc, char** argv) {
       const std::string v = value();
       if (v != "bars" && v != "planes") throw BadUsage("--scene must be bars or planes, got '" + v + "'");
       o.planes = v == "planes";
+    } else if (a == "--hud") {
+      const std::string v = value();
+      if (v == "arrays")
+        o.hud = Hud::arrays;
+      else if (v == "immediate")
+        o.hud = Hud::immediate;
+      else if (v == "list")
+        o.hud = Hud::list;
+      else if (v == "bitmap")
+        o.hud = Hud::bitmap;
+      else
+        throw BadUsage("--hud must be arrays, immediate, list or bitmap, got '" + v + "'");
     } else if (a == "--title") {
       o.title = value();
     } else if (a == "--log") {
@@ -147,13 +165,15 @@ Options parse(int argc, char** argv) {
       std::puts(
           "nelf-test-game [--toolkit glfw|sdl2] [--mode sbs|sbs-half|tab|tab-half|fp|quad-buffer] [--fps N]\n"
           "               [--size WxH] [--frames N] [--duration S] [--title T] [--log FILE]\n"
-          "               [--reopen-after N] [--exit-status N] [--scene bars|planes]");
+          "               [--reopen-after N] [--exit-status N] [--scene bars|planes]\n"
+          "               [--hud arrays|immediate|list|bitmap]");
       std::exit(0);
     } else {
       throw BadUsage("unknown option '" + a + "' (--help lists them)");
     }
   }
   if (o.title.empty()) o.title = "nelf test game " + o.mode_name;
+  if (o.hud != Hud::none && o.mode != Mode::quad_buffer) throw BadUsage("--hud needs --mode quad-buffer");
   return o;
 }
 
@@ -303,6 +323,64 @@ void draw_planes(const Rect& eye, int window_h, int eye_sign, GLuint texture) {
   glDisable(GL_DEPTH_TEST);
 }
 
+// The quad of the HUD's bar, `shift` (a fraction of the window) to the right, in immediate mode.
+void hud_bar(int w, int h, double shift) {
+  using namespace nelf::test_game;
+  glBegin(GL_QUADS);
+  glVertex2d((kHudX0 + shift) * w, kHudTop * h);
+  glVertex2d((kHudX1 + shift) * w, kHudTop * h);
+  glVertex2d((kHudX1 + shift) * w, kHudBottom * h);
+  glVertex2d((kHudX0 + shift) * w, kHudBottom * h);
+  glEnd();
+}
+
+// --hud: drawn over both eyes at once (GL_BACK), in window coordinates, white (hud.hpp).
+void draw_hud(Hud hud, int w, int h, GLuint list) {
+  using namespace nelf::test_game;
+  glDrawBuffer(GL_BACK);
+  glViewport(0, 0, w, h);
+  glScissor(0, 0, w, h);
+  glMatrixMode(GL_PROJECTION);
+  glLoadIdentity();
+  glOrtho(0, w, h, 0, -1, 1);
+  glMatrixMode(GL_MODELVIEW);
+  glLoadIdentity();
+  glColor3f(1, 1, 1);
+  switch (hud) {
+    case Hud::none:
+      return;
+    case Hud::arrays: {
+      const GLfloat corners[] = {static_cast<GLfloat>(kHudX0 * w), static_cast<GLfloat>(kHudTop * h),
+                                 static_cast<GLfloat>(kHudX1 * w), static_cast<GLfloat>(kHudTop * h),
+                                 static_cast<GLfloat>(kHudX1 * w), static_cast<GLfloat>(kHudBottom * h),
+                                 static_cast<GLfloat>(kHudX0 * w), static_cast<GLfloat>(kHudBottom * h)};
+      glEnableClientState(GL_VERTEX_ARRAY);
+      glVertexPointer(2, GL_FLOAT, 0, corners);
+      glDrawArrays(GL_TRIANGLE_FAN, 0, 4);
+      glDisableClientState(GL_VERTEX_ARRAY);
+      return;
+    }
+    case Hud::immediate:
+      hud_bar(w, h, 0);
+      return;
+    case Hud::list:
+      // The list draws the bar and moves the matrix; the bar drawn after it lands kHudListShift right.
+      glNewList(list, GL_COMPILE);
+      hud_bar(w, h, 0);
+      glTranslated(kHudListShift * w, 0, 0);
+      glEndList();
+      glCallList(list);
+      hud_bar(w, h, 0);
+      return;
+    case Hud::bitmap: {
+      const std::vector<GLubyte> block(kHudBlock * kHudBlock / 8 * 4, 0xFF);  // rows padded to 4 bytes
+      glRasterPos2d(kHudX0 * w, kHudBlockBottom * h);
+      for (int i = 0; i < kHudBlocks; ++i) glBitmap(kHudBlock, kHudBlock, 0, 0, kHudBlockStep, 0, block.data());
+      return;
+    }
+  }
+}
+
 std::int64_t now_ns() {
   timespec ts{};
   clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -415,7 +493,7 @@ int run(const Options& o) {
   int w = 0, h = 0;
   window_size(o, w, h);
   std::unique_ptr<GameWindow> window;
-  GLuint texture = 0;
+  GLuint texture = 0, hud_list = 0;
   const auto open_window = [&] {
     window.reset();  // the old one first: its toolkit is shut down and started again
     if (o.toolkit == Toolkit::glfw)
@@ -424,6 +502,7 @@ int run(const Options& o) {
       window = std::make_unique<SdlGameWindow>(o, w, h);
     glEnable(GL_SCISSOR_TEST);
     if (o.planes) texture = make_noise_texture();  // the new window's context has none
+    if (o.hud == Hud::list) hud_list = glGenLists(1);
   };
   open_window();
   const auto period = static_cast<std::int64_t>(std::llround(1e9 / o.fps));
@@ -450,6 +529,7 @@ int run(const Options& o) {
     if (o.mode == Mode::quad_buffer) glDrawBuffer(GL_BACK_RIGHT);
     if (o.planes) draw_planes(right, h, +1, texture);
     draw_eye(right, h, frame, o.fps, +1, stamp, o.planes);
+    if (o.hud != Hud::none) draw_hud(o.hud, w, h, hud_list);
     window->swap();
     if (log) std::fprintf(log.get(), "%ld,%lld\n", frame, static_cast<long long>(stamp.present_ns));
     deadline += period;

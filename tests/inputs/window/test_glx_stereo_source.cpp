@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/frame_stamp.hpp"
+#include "game/hud.hpp"
 #include "game/planes_scene.hpp"
 #include "inputs/glx_stereo_protocol.hpp"
 #include "inputs/glx_stereo_source.hpp"
@@ -191,6 +192,46 @@ TEST_F(GlxStereoSourceTest, AGameThatDrawsOnePictureOrNeverSwapsIsSaid) {
     EXPECT_NE(std::string(e.what()).find("socket=PATH is missing"), std::string::npos) << e.what();
   }
   EXPECT_THROW(open_source(quiet_request("glx-stereo:socket=" + socket(), StereoLayout::sbs)), UserError);
+}
+
+TEST_F(GlxStereoSourceTest, WhatTheGameDrawsIntoBothBackBuffersIsInBothEyes) {
+  // A HUD drawn with glDrawBuffer(GL_BACK) after the eyes, as games draw one (hud.hpp): with
+  // glDrawArrays, in immediate mode, through a display list that also moves the matrix, and with
+  // glBitmap, which moves the raster position. Each lands once in each eye, where the game put it.
+  using namespace test_game;
+  constexpr int kW = 320, kH = 180;
+  const auto white = [](const StereoVideoFrame& f, bool left, double x, double row) {
+    const std::uint8_t* p =
+        &(left ? f.left : f.right)[(static_cast<std::size_t>(row) * f.width + static_cast<std::size_t>(x)) * 4];
+    return p[0] > 230 && p[1] > 230 && p[2] > 230;
+  };
+  const double bar_x = (kHudX0 + kHudX1) / 2 * kW, bar_row = (kHudTop + kHudBottom) / 2 * kH;
+  for (const char* hud : {"arrays", "immediate", "list", "bitmap"}) {
+    SCOPED_TRACE(hud);
+    test::TestGame game({"--mode", "quad-buffer", "--size", "320x180", "--fps", "30", "--hud", hud}, interposed());
+    auto source = open_source(quiet_request("glx-stereo:wait=20,socket=" + socket()));
+    const std::optional<StereoVideoFrame> f = source->next();
+    ASSERT_TRUE(f);
+    ASSERT_EQ(f->width, kW);
+    ASSERT_EQ(f->bits, 8);
+    for (const bool left : {true, false}) {
+      SCOPED_TRACE(left ? "left eye" : "right eye");
+      if (std::string(hud) == "bitmap") {
+        const double row = kHudBlockBottom * kH - kHudBlock / 2.0;
+        for (int i = 0; i < kHudBlocks + 3; ++i) {
+          const double x = kHudX0 * kW + i * kHudBlockStep;
+          EXPECT_EQ(white(*f, left, x + kHudBlock / 2.0, row), i < kHudBlocks) << "block " << i;
+          EXPECT_FALSE(white(*f, left, x + kHudBlock * 1.5, row)) << "after block " << i;
+        }
+        continue;
+      }
+      EXPECT_TRUE(white(*f, left, bar_x, bar_row));
+      if (std::string(hud) == "list") {
+        EXPECT_TRUE(white(*f, left, bar_x + kHudListShift * kW, bar_row));
+        EXPECT_FALSE(white(*f, left, bar_x + 2 * kHudListShift * kW, bar_row));
+      }
+    }
+  }
 }
 
 }  // namespace
