@@ -171,13 +171,14 @@ class GlxStereoSource final : public Source {
         }
         if (r->message.type == protocol::MessageType::frame && r->message.slot < protocol::kSlots) newest = r->message;
       }
+      // Overwritten while copied: the game drew faster than nelf reads, and its next frame is newer
+      // anyway. Not a lost frame (the play summary's "lost to decode errors"), any more than the
+      // older frames passed over above: like every live source, this one shows the newest.
       if (std::optional<StereoVideoFrame> frame = copy(*newest)) return frame;
-      ++lost_;  // overwritten while copied: the next one is newer anyway
     }
   }
 
   void interrupt() override { interrupted_ = true; }
-  std::int64_t lost_frames() const override { return lost_; }
 
   ViewFormat negotiate(const ViewFormat& wanted) override {
     const auto& [bx, by] = wanted.block;
@@ -269,7 +270,6 @@ class GlxStereoSource final : public Source {
   std::chrono::steady_clock::time_point origin_;
   std::string description_;
   std::atomic<bool> interrupted_{false};
-  std::int64_t lost_ = 0;
   std::array<int, 2> block_{1, 1};
 };
 
