@@ -713,6 +713,8 @@ NELF_INTO_EYES(glBlitFramebuffer,
                (sx0, sy0, sx1, sy1, dx0, dy0, dx1, dy1, mask, filter))
 NELF_INTO_EYES(glDrawPixels, (GLsizei width, GLsizei height, GLenum format, GLenum type, const void* pixels),
                (width, height, format, type, pixels))
+NELF_INTO_EYES(glCopyPixels, (GLint x, GLint y, GLsizei width, GLsizei height, GLenum type),
+               (x, y, width, height, type))
 NELF_INTO_EYES(glRectf, (GLfloat x1, GLfloat y1, GLfloat x2, GLfloat y2), (x1, y1, x2, y2))
 NELF_INTO_EYES(glRectd, (GLdouble x1, GLdouble y1, GLdouble x2, GLdouble y2), (x1, y1, x2, y2))
 NELF_INTO_EYES(glRecti, (GLint x1, GLint y1, GLint x2, GLint y2), (x1, y1, x2, y2))
@@ -839,6 +841,7 @@ void* interposed(const char* name) {
       {"glBlitFramebuffer", reinterpret_cast<void*>(&glBlitFramebuffer)},
       {"glBlitFramebufferEXT", reinterpret_cast<void*>(&glBlitFramebuffer)},
       {"glDrawPixels", reinterpret_cast<void*>(&glDrawPixels)},
+      {"glCopyPixels", reinterpret_cast<void*>(&glCopyPixels)},
       {"glRectf", reinterpret_cast<void*>(&glRectf)},
       {"glRectd", reinterpret_cast<void*>(&glRectd)},
       {"glRecti", reinterpret_cast<void*>(&glRecti)},

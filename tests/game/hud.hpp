@@ -4,10 +4,11 @@
 // tests of the interposer look for it in both eyes, here. Fractions of the window, rows from the top.
 namespace nelf::test_game {
 
-// A white bar (arrays, immediate, list).
+// A white bar (arrays, immediate, list, copy).
 inline constexpr double kHudX0 = 0.05, kHudX1 = 0.25, kHudTop = 0.78, kHudBottom = 0.86;
 // --hud list: the list draws the bar and moves the modelview matrix this far right; the game then
 // draws the bar again, which lands here once, and twice as far were the list's move made twice.
+// --hud copy: the bar, and glCopyPixels of it this far right.
 inline constexpr double kHudListShift = 0.3;
 // --hud bitmap: kHudBlocks white blocks of kHudBlock pixels, kHudBlockStep apart (glBitmap moves the
 // raster position), the first's left edge at kHudX0 and its bottom edge at kHudBlockBottom.

@@ -7,7 +7,7 @@
 //   nelf-test-game [--toolkit glfw|sdl2] [--mode sbs|sbs-half|tab|tab-half|fp|quad-buffer]
 //                  [--fps N] [--size WxH] [--frames N] [--duration S] [--title T] [--log FILE]
 //                  [--reopen-after N] [--exit-status N] [--scene bars|planes]
-//                  [--hud arrays|immediate|list|bitmap]
+//                  [--hud arrays|immediate|list|bitmap|copy]
 //
 // --size is one eye's size (default 1280x720); the window is sized from it and the mode (fp: the
 // frame-packed window of that eye size, 1280x720 → 1280x1470). The game follows its window's size
@@ -18,8 +18,8 @@
 // with (after --frames or --duration), for the tests of `nelf run`. --scene planes draws, instead of
 // the flat bars, two textured planes in perspective with a depth buffer, as a 3D game does
 // (planes_scene.hpp), for the tests of the game's depth. --hud (quad-buffer only) draws a HUD over
-// both eyes at once with glDrawBuffer(GL_BACK), with glDrawArrays, glBegin/glEnd, a display list or
-// glBitmap (hud.hpp).
+// both eyes at once with glDrawBuffer(GL_BACK), with glDrawArrays, glBegin/glEnd, a display list,
+// glBitmap or glCopyPixels (hud.hpp).
 // epoxy before the toolkits' headers, which would include GL/gl.h.
 #include <epoxy/gl.h>
 
@@ -52,7 +52,7 @@ extern "C" void on_signal(int) { g_stop = true; }
 
 enum class Toolkit { glfw, sdl2 };
 enum class Mode { sbs, sbs_half, tab, tab_half, fp, quad_buffer };
-enum class Hud { none, arrays, immediate, list, bitmap };
+enum class Hud { none, arrays, immediate, list, bitmap, copy };
 
 struct Options {
   Toolkit toolkit = Toolkit::glfw;
@@ -147,8 +147,10 @@ Options parse(int argc, char** argv) {
         o.hud = Hud::list;
       else if (v == "bitmap")
         o.hud = Hud::bitmap;
+      else if (v == "copy")
+        o.hud = Hud::copy;
       else
-        throw BadUsage("--hud must be arrays, immediate, list or bitmap, got '" + v + "'");
+        throw BadUsage("--hud must be arrays, immediate, list, bitmap or copy, got '" + v + "'");
     } else if (a == "--title") {
       o.title = value();
     } else if (a == "--log") {
@@ -166,7 +168,7 @@ Options parse(int argc, char** argv) {
           "nelf-test-game [--toolkit glfw|sdl2] [--mode sbs|sbs-half|tab|tab-half|fp|quad-buffer] [--fps N]\n"
           "               [--size WxH] [--frames N] [--duration S] [--title T] [--log FILE]\n"
           "               [--reopen-after N] [--exit-status N] [--scene bars|planes]\n"
-          "               [--hud arrays|immediate|list|bitmap]");
+          "               [--hud arrays|immediate|list|bitmap|copy]");
       std::exit(0);
     } else {
       throw BadUsage("unknown option '" + a + "' (--help lists them)");
@@ -371,6 +373,14 @@ void draw_hud(Hud hud, int w, int h, GLuint list) {
       glEndList();
       glCallList(list);
       hud_bar(w, h, 0);
+      return;
+    case Hud::copy:
+      // The bar, then a copy of it kHudListShift to the right, read from GL_BACK (the left eye).
+      hud_bar(w, h, 0);
+      glRasterPos2d((kHudX0 + kHudListShift) * w, kHudBottom * h);
+      glCopyPixels(static_cast<GLint>(kHudX0 * w), static_cast<GLint>(h - kHudBottom * h),
+                   static_cast<GLsizei>((kHudX1 - kHudX0) * w), static_cast<GLsizei>((kHudBottom - kHudTop) * h),
+                   GL_COLOR);
       return;
     case Hud::bitmap: {
       const std::vector<GLubyte> block(kHudBlock * kHudBlock / 8 * 4, 0xFF);  // rows padded to 4 bytes

@@ -196,8 +196,9 @@ TEST_F(GlxStereoSourceTest, AGameThatDrawsOnePictureOrNeverSwapsIsSaid) {
 
 TEST_F(GlxStereoSourceTest, WhatTheGameDrawsIntoBothBackBuffersIsInBothEyes) {
   // A HUD drawn with glDrawBuffer(GL_BACK) after the eyes, as games draw one (hud.hpp): with
-  // glDrawArrays, in immediate mode, through a display list that also moves the matrix, and with
-  // glBitmap, which moves the raster position. Each lands once in each eye, where the game put it.
+  // glDrawArrays, in immediate mode, through a display list that also moves the matrix, with
+  // glBitmap, which moves the raster position, and glCopyPixels. Each lands once in each eye, where
+  // the game put it.
   using namespace test_game;
   constexpr int kW = 320, kH = 180;
   const auto white = [](const StereoVideoFrame& f, bool left, double x, double row) {
@@ -206,7 +207,7 @@ TEST_F(GlxStereoSourceTest, WhatTheGameDrawsIntoBothBackBuffersIsInBothEyes) {
     return p[0] > 230 && p[1] > 230 && p[2] > 230;
   };
   const double bar_x = (kHudX0 + kHudX1) / 2 * kW, bar_row = (kHudTop + kHudBottom) / 2 * kH;
-  for (const char* hud : {"arrays", "immediate", "list", "bitmap"}) {
+  for (const char* hud : {"arrays", "immediate", "list", "bitmap", "copy"}) {
     SCOPED_TRACE(hud);
     test::TestGame game({"--mode", "quad-buffer", "--size", "320x180", "--fps", "30", "--hud", hud}, interposed());
     auto source = open_source(quiet_request("glx-stereo:wait=20,socket=" + socket()));
@@ -226,7 +227,7 @@ TEST_F(GlxStereoSourceTest, WhatTheGameDrawsIntoBothBackBuffersIsInBothEyes) {
         continue;
       }
       EXPECT_TRUE(white(*f, left, bar_x, bar_row));
-      if (std::string(hud) == "list") {
+      if (std::string(hud) == "list" || std::string(hud) == "copy") {
         EXPECT_TRUE(white(*f, left, bar_x + kHudListShift * kW, bar_row));
         EXPECT_FALSE(white(*f, left, bar_x + 2 * kHudListShift * kW, bar_row));
       }
