@@ -205,7 +205,7 @@ struct PipeWireCapture::State {
     auto* s = static_cast<State*>(data);
     if (info->state == PW_LINK_STATE_ERROR)
       s->end(fmt::format("the link to the node failed ({}); nelf reads {} in shared memory",
-                         info->error ? info->error : "no reason given", PipeWireFrameReader::kFormatsRead));
+                         info->error ? info->error : "no reason given", PipeWireFrameReader::formats_in_words()));
   }
   static void on_param_changed(void* data, uint32_t id, const spa_pod* param) {
     auto* s = static_cast<State*>(data);
@@ -424,18 +424,21 @@ PipeWireCapture::PipeWireCapture(const PipeWireCaptureSpec& spec, std::string in
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpedantic"
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-  const auto* formats = static_cast<const spa_pod*>(spa_pod_builder_add_object(
-      &b, SPA_TYPE_OBJECT_Format, SPA_PARAM_EnumFormat, SPA_FORMAT_mediaType, SPA_POD_Id(SPA_MEDIA_TYPE_video),
-      SPA_FORMAT_mediaSubtype, SPA_POD_Id(SPA_MEDIA_SUBTYPE_raw), SPA_FORMAT_VIDEO_format,
-      // RGB first (a desktop's own order, nothing to convert), then the YUV formats.
-      SPA_POD_CHOICE_ENUM_Id(20, SPA_VIDEO_FORMAT_BGRx, SPA_VIDEO_FORMAT_BGRx, SPA_VIDEO_FORMAT_BGRA,
-                             SPA_VIDEO_FORMAT_RGBx, SPA_VIDEO_FORMAT_RGBA, SPA_VIDEO_FORMAT_xRGB, SPA_VIDEO_FORMAT_ARGB,
-                             SPA_VIDEO_FORMAT_xBGR, SPA_VIDEO_FORMAT_ABGR, SPA_VIDEO_FORMAT_RGB, SPA_VIDEO_FORMAT_BGR,
-                             SPA_VIDEO_FORMAT_I420, SPA_VIDEO_FORMAT_YV12, SPA_VIDEO_FORMAT_NV12, SPA_VIDEO_FORMAT_NV21,
-                             SPA_VIDEO_FORMAT_YUY2, SPA_VIDEO_FORMAT_UYVY, SPA_VIDEO_FORMAT_YVYU, SPA_VIDEO_FORMAT_Y42B,
-                             SPA_VIDEO_FORMAT_Y444),  // the formats PipeWireFrameReader reads
-      SPA_FORMAT_VIDEO_size, SPA_POD_CHOICE_RANGE_Rectangle(&size_default, &size_min, &size_max),
-      SPA_FORMAT_VIDEO_framerate, SPA_POD_CHOICE_RANGE_Fraction(&rate_default, &rate_min, &rate_max)));
+  // The formats PipeWireFrameReader reads, its first the default.
+  const std::vector<spa_video_format> readable = PipeWireFrameReader::formats();
+  spa_pod_frame object{}, choice{};
+  spa_pod_builder_push_object(&b, &object, SPA_TYPE_OBJECT_Format, SPA_PARAM_EnumFormat);
+  spa_pod_builder_add(&b, SPA_FORMAT_mediaType, SPA_POD_Id(SPA_MEDIA_TYPE_video), SPA_FORMAT_mediaSubtype,
+                      SPA_POD_Id(SPA_MEDIA_SUBTYPE_raw), 0);
+  spa_pod_builder_prop(&b, SPA_FORMAT_VIDEO_format, 0);
+  spa_pod_builder_push_choice(&b, &choice, SPA_CHOICE_Enum, 0);
+  spa_pod_builder_id(&b, readable.front());
+  for (const spa_video_format f : readable) spa_pod_builder_id(&b, f);
+  spa_pod_builder_pop(&b, &choice);
+  spa_pod_builder_add(&b, SPA_FORMAT_VIDEO_size, SPA_POD_CHOICE_RANGE_Rectangle(&size_default, &size_min, &size_max),
+                      SPA_FORMAT_VIDEO_framerate, SPA_POD_CHOICE_RANGE_Fraction(&rate_default, &rate_min, &rate_max),
+                      0);
+  const auto* formats = static_cast<const spa_pod*>(spa_pod_builder_pop(&b, &object));
 #pragma GCC diagnostic pop
   const auto flags = static_cast<pw_stream_flags>(PW_STREAM_FLAG_MAP_BUFFERS |
                                                   (s.portal ? PW_STREAM_FLAG_AUTOCONNECT : PW_STREAM_FLAG_NONE));

@@ -13,31 +13,36 @@ extern "C" {
 namespace nelf {
 namespace {
 
-// The YUV formats nelf reads, as FFmpeg's pixel formats (YV12 is I420 with its chroma planes the
-// other way round: swapped when read).
-AVPixelFormat yuv_format(spa_video_format format) {
-  switch (format) {
-    case SPA_VIDEO_FORMAT_I420:
-    case SPA_VIDEO_FORMAT_YV12:
-      return AV_PIX_FMT_YUV420P;
-    case SPA_VIDEO_FORMAT_NV12:
-      return AV_PIX_FMT_NV12;
-    case SPA_VIDEO_FORMAT_NV21:
-      return AV_PIX_FMT_NV21;
-    case SPA_VIDEO_FORMAT_YUY2:
-      return AV_PIX_FMT_YUYV422;
-    case SPA_VIDEO_FORMAT_UYVY:
-      return AV_PIX_FMT_UYVY422;
-    case SPA_VIDEO_FORMAT_YVYU:
-      return AV_PIX_FMT_YVYU422;
-    case SPA_VIDEO_FORMAT_Y42B:
-      return AV_PIX_FMT_YUV422P;
-    case SPA_VIDEO_FORMAT_Y444:
-      return AV_PIX_FMT_YUV444P;
-    default:
-      return AV_PIX_FMT_NONE;
-  }
-}
+// Every format read: its name, and for RGB the bytes a pixel and where R, G and B sit in it, for
+// YUV FFmpeg's name of it (YV12 is I420 with its chroma planes the other way round: swapped when
+// read). In the order a stream offers them.
+struct ReadFormat {
+  spa_video_format format;
+  const char* name;
+  int bytes, r, g, b;  // RGB; bytes 0 for YUV
+  AVPixelFormat yuv;
+};
+constexpr ReadFormat kReadFormats[] = {
+    {SPA_VIDEO_FORMAT_BGRx, "BGRx", 4, 2, 1, 0, AV_PIX_FMT_NONE},
+    {SPA_VIDEO_FORMAT_BGRA, "BGRA", 4, 2, 1, 0, AV_PIX_FMT_NONE},
+    {SPA_VIDEO_FORMAT_RGBx, "RGBx", 4, 0, 1, 2, AV_PIX_FMT_NONE},
+    {SPA_VIDEO_FORMAT_RGBA, "RGBA", 4, 0, 1, 2, AV_PIX_FMT_NONE},
+    {SPA_VIDEO_FORMAT_xRGB, "xRGB", 4, 1, 2, 3, AV_PIX_FMT_NONE},
+    {SPA_VIDEO_FORMAT_ARGB, "ARGB", 4, 1, 2, 3, AV_PIX_FMT_NONE},
+    {SPA_VIDEO_FORMAT_xBGR, "xBGR", 4, 3, 2, 1, AV_PIX_FMT_NONE},
+    {SPA_VIDEO_FORMAT_ABGR, "ABGR", 4, 3, 2, 1, AV_PIX_FMT_NONE},
+    {SPA_VIDEO_FORMAT_RGB, "RGB", 3, 0, 1, 2, AV_PIX_FMT_NONE},
+    {SPA_VIDEO_FORMAT_BGR, "BGR", 3, 2, 1, 0, AV_PIX_FMT_NONE},
+    {SPA_VIDEO_FORMAT_I420, "I420", 0, 0, 0, 0, AV_PIX_FMT_YUV420P},
+    {SPA_VIDEO_FORMAT_YV12, "YV12", 0, 0, 0, 0, AV_PIX_FMT_YUV420P},
+    {SPA_VIDEO_FORMAT_NV12, "NV12", 0, 0, 0, 0, AV_PIX_FMT_NV12},
+    {SPA_VIDEO_FORMAT_NV21, "NV21", 0, 0, 0, 0, AV_PIX_FMT_NV21},
+    {SPA_VIDEO_FORMAT_YUY2, "YUY2", 0, 0, 0, 0, AV_PIX_FMT_YUYV422},
+    {SPA_VIDEO_FORMAT_UYVY, "UYVY", 0, 0, 0, 0, AV_PIX_FMT_UYVY422},
+    {SPA_VIDEO_FORMAT_YVYU, "YVYU", 0, 0, 0, 0, AV_PIX_FMT_YVYU422},
+    {SPA_VIDEO_FORMAT_Y42B, "Y42B", 0, 0, 0, 0, AV_PIX_FMT_YUV422P},
+    {SPA_VIDEO_FORMAT_Y444, "Y444", 0, 0, 0, 0, AV_PIX_FMT_YUV444P},
+};
 
 // swscale's coefficients for the node's matrix; when it gives none, BT.601 up to 576 rows and
 // BT.709 above, as FFmpeg and mpv guess.
@@ -72,36 +77,27 @@ bool holds_frame(const spa_data& d) {
 
 }  // namespace
 
+std::vector<spa_video_format> PipeWireFrameReader::formats() {
+  std::vector<spa_video_format> out;
+  for (const ReadFormat& f : kReadFormats) out.push_back(f.format);
+  return out;
+}
+
+std::string PipeWireFrameReader::formats_in_words() {
+  std::string rgb, yuv;
+  for (const ReadFormat& f : kReadFormats) {
+    std::string& list = f.bytes > 0 ? rgb : yuv;
+    list += (list.empty() ? "" : ", ") + std::string(f.name);
+  }
+  return "8-bit RGB frames (" + rgb + ") and 8-bit YUV ones (" + yuv + ")";
+}
+
 PipeWireFrameReader::PipeWireFrameReader(const spa_video_info_raw& format)
-    : format_(format),
-      width_(static_cast<int>(format.size.width)),
-      height_(static_cast<int>(format.size.height)),
-      yuv_(yuv_format(format.format)) {
-  switch (format.format) {
-    case SPA_VIDEO_FORMAT_RGBA:
-    case SPA_VIDEO_FORMAT_RGBx:
-      rgb_ = PixelOrder{4, 0, 1, 2};
-      break;
-    case SPA_VIDEO_FORMAT_BGRA:
-    case SPA_VIDEO_FORMAT_BGRx:
-      rgb_ = PixelOrder{4, 2, 1, 0};
-      break;
-    case SPA_VIDEO_FORMAT_xRGB:
-    case SPA_VIDEO_FORMAT_ARGB:
-      rgb_ = PixelOrder{4, 1, 2, 3};
-      break;
-    case SPA_VIDEO_FORMAT_xBGR:
-    case SPA_VIDEO_FORMAT_ABGR:
-      rgb_ = PixelOrder{4, 3, 2, 1};
-      break;
-    case SPA_VIDEO_FORMAT_RGB:
-      rgb_ = PixelOrder{3, 0, 1, 2};
-      break;
-    case SPA_VIDEO_FORMAT_BGR:
-      rgb_ = PixelOrder{3, 2, 1, 0};
-      break;
-    default:
-      break;
+    : format_(format), width_(static_cast<int>(format.size.width)), height_(static_cast<int>(format.size.height)) {
+  for (const ReadFormat& f : kReadFormats) {
+    if (f.format != format.format) continue;
+    if (f.bytes > 0) rgb_ = PixelOrder{f.bytes, f.r, f.g, f.b};
+    yuv_ = f.yuv;
   }
 }
 

@@ -4,6 +4,8 @@
 // RGB in any byte order is copied; 8-bit YUV (what cameras, capture cards' nodes and encoders send)
 // goes through swscale, with the node's matrix and range.
 #include <optional>
+#include <string>
+#include <vector>
 
 // SPA's headers are C: compound literals and designated initialisers that -Wpedantic rejects in C++.
 #pragma GCC diagnostic push
@@ -20,10 +22,10 @@ namespace nelf {
 
 class PipeWireFrameReader {
  public:
-  // What a link error tells the user nelf can read.
-  static constexpr const char* kFormatsRead =
-      "8-bit RGB frames (BGRx, RGBx, BGRA, RGBA, RGB, BGR) and 8-bit YUV ones (I420, YV12, NV12, NV21, YUY2, UYVY, "
-      "YVYU, Y42B, Y444)";
+  // The formats read, in the order a stream offers them (RGB first: a desktop's own order, nothing
+  // to convert), and the same in words for a link error.
+  static std::vector<spa_video_format> formats();
+  static std::string formats_in_words();
 
   // For frames of `format`, as the stream negotiated it.
   explicit PipeWireFrameReader(const spa_video_info_raw& format);
