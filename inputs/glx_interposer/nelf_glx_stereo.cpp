@@ -37,6 +37,7 @@
 #include <cstring>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -668,57 +669,54 @@ __attribute__((visibility("default"))) void glGetBooleanv(GLenum name, GLboolean
   if (name == GL_STEREO && t_current) *data = GL_TRUE;
 }
 
-// Drawing into both back buffers (GL_BACK on a stereo framebuffer) draws into both eyes: each call
-// below is made into each eye's framebuffer (into_eyes).
+// Drawing into both back buffers (GL_BACK on a stereo framebuffer) draws into both eyes: each of
+// these calls, as (name, parameters, arguments), is defined below to be made into each eye's
+// framebuffer (into_eyes), and answered for by name in interposed().
+#define NELF_INTO_EYES_CALLS(X)                                                                                     \
+  X(glClear, (GLbitfield mask), (mask))                                                                             \
+  X(glClearBufferfv, (GLenum buffer, GLint drawbuffer, const GLfloat* value), (buffer, drawbuffer, value))          \
+  X(glClearBufferiv, (GLenum buffer, GLint drawbuffer, const GLint* value), (buffer, drawbuffer, value))            \
+  X(glClearBufferuiv, (GLenum buffer, GLint drawbuffer, const GLuint* value), (buffer, drawbuffer, value))          \
+  X(glClearBufferfi, (GLenum buffer, GLint drawbuffer, GLfloat depth, GLint stencil),                               \
+    (buffer, drawbuffer, depth, stencil))                                                                           \
+  X(glDrawArrays, (GLenum mode, GLint first, GLsizei count), (mode, first, count))                                  \
+  X(glDrawElements, (GLenum mode, GLsizei count, GLenum type, const void* indices), (mode, count, type, indices))   \
+  X(glDrawRangeElements, (GLenum mode, GLuint start, GLuint end, GLsizei count, GLenum type, const void* indices),  \
+    (mode, start, end, count, type, indices))                                                                       \
+  X(glDrawArraysInstanced, (GLenum mode, GLint first, GLsizei count, GLsizei instances),                            \
+    (mode, first, count, instances))                                                                                \
+  X(glDrawElementsInstanced, (GLenum mode, GLsizei count, GLenum type, const void* indices, GLsizei instances),     \
+    (mode, count, type, indices, instances))                                                                        \
+  X(glDrawElementsBaseVertex, (GLenum mode, GLsizei count, GLenum type, const void* indices, GLint base),           \
+    (mode, count, type, indices, base))                                                                             \
+  X(glDrawRangeElementsBaseVertex,                                                                                  \
+    (GLenum mode, GLuint start, GLuint end, GLsizei count, GLenum type, const void* indices, GLint base),           \
+    (mode, start, end, count, type, indices, base))                                                                 \
+  X(glDrawElementsInstancedBaseVertex,                                                                              \
+    (GLenum mode, GLsizei count, GLenum type, const void* indices, GLsizei instances, GLint base),                  \
+    (mode, count, type, indices, instances, base))                                                                  \
+  X(glMultiDrawArrays, (GLenum mode, const GLint* first, const GLsizei* count, GLsizei n), (mode, first, count, n)) \
+  X(glMultiDrawElements, (GLenum mode, const GLsizei* count, GLenum type, const void* const* indices, GLsizei n),   \
+    (mode, count, type, indices, n))                                                                                \
+  X(glDrawArraysIndirect, (GLenum mode, const void* indirect), (mode, indirect))                                    \
+  X(glDrawElementsIndirect, (GLenum mode, GLenum type, const void* indirect), (mode, type, indirect))               \
+  X(glBlitFramebuffer,                                                                                              \
+    (GLint sx0, GLint sy0, GLint sx1, GLint sy1, GLint dx0, GLint dy0, GLint dx1, GLint dy1, GLbitfield mask,       \
+     GLenum filter),                                                                                                \
+    (sx0, sy0, sx1, sy1, dx0, dy0, dx1, dy1, mask, filter))                                                         \
+  X(glDrawPixels, (GLsizei width, GLsizei height, GLenum format, GLenum type, const void* pixels),                  \
+    (width, height, format, type, pixels))                                                                          \
+  X(glCopyPixels, (GLint x, GLint y, GLsizei width, GLsizei height, GLenum type), (x, y, width, height, type))      \
+  X(glRectf, (GLfloat x1, GLfloat y1, GLfloat x2, GLfloat y2), (x1, y1, x2, y2))                                    \
+  X(glRectd, (GLdouble x1, GLdouble y1, GLdouble x2, GLdouble y2), (x1, y1, x2, y2))                                \
+  X(glRecti, (GLint x1, GLint y1, GLint x2, GLint y2), (x1, y1, x2, y2))                                            \
+  X(glRects, (GLshort x1, GLshort y1, GLshort x2, GLshort y2), (x1, y1, x2, y2))
 #define NELF_INTO_EYES(name, parameters, arguments)             \
   __attribute__((visibility("default"))) void name parameters { \
     NELF_REAL_GL(name);                                         \
     into_eyes([&] { real_##name arguments; });                  \
   }
-NELF_INTO_EYES(glClear, (GLbitfield mask), (mask))
-NELF_INTO_EYES(glClearBufferfv, (GLenum buffer, GLint drawbuffer, const GLfloat* value), (buffer, drawbuffer, value))
-NELF_INTO_EYES(glClearBufferiv, (GLenum buffer, GLint drawbuffer, const GLint* value), (buffer, drawbuffer, value))
-NELF_INTO_EYES(glClearBufferuiv, (GLenum buffer, GLint drawbuffer, const GLuint* value), (buffer, drawbuffer, value))
-NELF_INTO_EYES(glClearBufferfi, (GLenum buffer, GLint drawbuffer, GLfloat depth, GLint stencil),
-               (buffer, drawbuffer, depth, stencil))
-NELF_INTO_EYES(glDrawArrays, (GLenum mode, GLint first, GLsizei count), (mode, first, count))
-NELF_INTO_EYES(glDrawElements, (GLenum mode, GLsizei count, GLenum type, const void* indices),
-               (mode, count, type, indices))
-NELF_INTO_EYES(glDrawRangeElements,
-               (GLenum mode, GLuint start, GLuint end, GLsizei count, GLenum type, const void* indices),
-               (mode, start, end, count, type, indices))
-NELF_INTO_EYES(glDrawArraysInstanced, (GLenum mode, GLint first, GLsizei count, GLsizei instances),
-               (mode, first, count, instances))
-NELF_INTO_EYES(glDrawElementsInstanced,
-               (GLenum mode, GLsizei count, GLenum type, const void* indices, GLsizei instances),
-               (mode, count, type, indices, instances))
-NELF_INTO_EYES(glDrawElementsBaseVertex, (GLenum mode, GLsizei count, GLenum type, const void* indices, GLint base),
-               (mode, count, type, indices, base))
-NELF_INTO_EYES(glDrawRangeElementsBaseVertex,
-               (GLenum mode, GLuint start, GLuint end, GLsizei count, GLenum type, const void* indices, GLint base),
-               (mode, start, end, count, type, indices, base))
-NELF_INTO_EYES(glDrawElementsInstancedBaseVertex,
-               (GLenum mode, GLsizei count, GLenum type, const void* indices, GLsizei instances, GLint base),
-               (mode, count, type, indices, instances, base))
-NELF_INTO_EYES(glMultiDrawArrays, (GLenum mode, const GLint* first, const GLsizei* count, GLsizei n),
-               (mode, first, count, n))
-NELF_INTO_EYES(glMultiDrawElements,
-               (GLenum mode, const GLsizei* count, GLenum type, const void* const* indices, GLsizei n),
-               (mode, count, type, indices, n))
-NELF_INTO_EYES(glDrawArraysIndirect, (GLenum mode, const void* indirect), (mode, indirect))
-NELF_INTO_EYES(glDrawElementsIndirect, (GLenum mode, GLenum type, const void* indirect), (mode, type, indirect))
-NELF_INTO_EYES(glBlitFramebuffer,
-               (GLint sx0, GLint sy0, GLint sx1, GLint sy1, GLint dx0, GLint dy0, GLint dx1, GLint dy1, GLbitfield mask,
-                GLenum filter),
-               (sx0, sy0, sx1, sy1, dx0, dy0, dx1, dy1, mask, filter))
-NELF_INTO_EYES(glDrawPixels, (GLsizei width, GLsizei height, GLenum format, GLenum type, const void* pixels),
-               (width, height, format, type, pixels))
-NELF_INTO_EYES(glCopyPixels, (GLint x, GLint y, GLsizei width, GLsizei height, GLenum type),
-               (x, y, width, height, type))
-NELF_INTO_EYES(glRectf, (GLfloat x1, GLfloat y1, GLfloat x2, GLfloat y2), (x1, y1, x2, y2))
-NELF_INTO_EYES(glRectd, (GLdouble x1, GLdouble y1, GLdouble x2, GLdouble y2), (x1, y1, x2, y2))
-NELF_INTO_EYES(glRecti, (GLint x1, GLint y1, GLint x2, GLint y2), (x1, y1, x2, y2))
-NELF_INTO_EYES(glRects, (GLshort x1, GLshort y1, GLshort x2, GLshort y2), (x1, y1, x2, y2))
+NELF_INTO_EYES_CALLS(NELF_INTO_EYES)
 #undef NELF_INTO_EYES
 
 // These change state (a list may set the colour or a matrix; glBitmap moves the raster position):
@@ -813,39 +811,15 @@ void* interposed(const char* name) {
       {"glBindFramebufferEXT", reinterpret_cast<void*>(&glBindFramebufferEXT)},
       {"glGetIntegerv", reinterpret_cast<void*>(&glGetIntegerv)},
       {"glGetBooleanv", reinterpret_cast<void*>(&glGetBooleanv)},
-      {"glClear", reinterpret_cast<void*>(&glClear)},
-      {"glClearBufferfv", reinterpret_cast<void*>(&glClearBufferfv)},
-      {"glClearBufferiv", reinterpret_cast<void*>(&glClearBufferiv)},
-      {"glClearBufferuiv", reinterpret_cast<void*>(&glClearBufferuiv)},
-      {"glClearBufferfi", reinterpret_cast<void*>(&glClearBufferfi)},
-      {"glDrawArrays", reinterpret_cast<void*>(&glDrawArrays)},
       {"glDrawArraysEXT", reinterpret_cast<void*>(&glDrawArrays)},
-      {"glDrawElements", reinterpret_cast<void*>(&glDrawElements)},
-      {"glDrawRangeElements", reinterpret_cast<void*>(&glDrawRangeElements)},
       {"glDrawRangeElementsEXT", reinterpret_cast<void*>(&glDrawRangeElements)},
-      {"glDrawArraysInstanced", reinterpret_cast<void*>(&glDrawArraysInstanced)},
       {"glDrawArraysInstancedARB", reinterpret_cast<void*>(&glDrawArraysInstanced)},
       {"glDrawArraysInstancedEXT", reinterpret_cast<void*>(&glDrawArraysInstanced)},
-      {"glDrawElementsInstanced", reinterpret_cast<void*>(&glDrawElementsInstanced)},
       {"glDrawElementsInstancedARB", reinterpret_cast<void*>(&glDrawElementsInstanced)},
       {"glDrawElementsInstancedEXT", reinterpret_cast<void*>(&glDrawElementsInstanced)},
-      {"glDrawElementsBaseVertex", reinterpret_cast<void*>(&glDrawElementsBaseVertex)},
-      {"glDrawRangeElementsBaseVertex", reinterpret_cast<void*>(&glDrawRangeElementsBaseVertex)},
-      {"glDrawElementsInstancedBaseVertex", reinterpret_cast<void*>(&glDrawElementsInstancedBaseVertex)},
-      {"glMultiDrawArrays", reinterpret_cast<void*>(&glMultiDrawArrays)},
       {"glMultiDrawArraysEXT", reinterpret_cast<void*>(&glMultiDrawArrays)},
-      {"glMultiDrawElements", reinterpret_cast<void*>(&glMultiDrawElements)},
       {"glMultiDrawElementsEXT", reinterpret_cast<void*>(&glMultiDrawElements)},
-      {"glDrawArraysIndirect", reinterpret_cast<void*>(&glDrawArraysIndirect)},
-      {"glDrawElementsIndirect", reinterpret_cast<void*>(&glDrawElementsIndirect)},
-      {"glBlitFramebuffer", reinterpret_cast<void*>(&glBlitFramebuffer)},
       {"glBlitFramebufferEXT", reinterpret_cast<void*>(&glBlitFramebuffer)},
-      {"glDrawPixels", reinterpret_cast<void*>(&glDrawPixels)},
-      {"glCopyPixels", reinterpret_cast<void*>(&glCopyPixels)},
-      {"glRectf", reinterpret_cast<void*>(&glRectf)},
-      {"glRectd", reinterpret_cast<void*>(&glRectd)},
-      {"glRecti", reinterpret_cast<void*>(&glRecti)},
-      {"glRects", reinterpret_cast<void*>(&glRects)},
       {"glCallList", reinterpret_cast<void*>(&glCallList)},
       {"glCallLists", reinterpret_cast<void*>(&glCallLists)},
       {"glBitmap", reinterpret_cast<void*>(&glBitmap)},
@@ -854,9 +828,17 @@ void* interposed(const char* name) {
       {"glBegin", reinterpret_cast<void*>(&glBegin)},
       {"glEnd", reinterpret_cast<void*>(&glEnd)},
   };
+  // clang-format off
+  static const Entry into_eyes_table[] = {
+#define NELF_ENTRY(name, parameters, arguments) {#name, reinterpret_cast<void*>(&name)},
+      NELF_INTO_EYES_CALLS(NELF_ENTRY)
+#undef NELF_ENTRY
+  };
+  // clang-format on
   if (!name || name[0] != 'g' || name[1] != 'l') return nullptr;
-  for (const Entry& entry : table)
-    if (std::strcmp(entry.name, name) == 0) return entry.function;
+  for (const std::span<const Entry> entries : {std::span<const Entry>(table), std::span<const Entry>(into_eyes_table)})
+    for (const Entry& entry : entries)
+      if (std::strcmp(entry.name, name) == 0) return entry.function;
   return nullptr;
 }
 
