@@ -1,6 +1,6 @@
 // The depth-aware composite's search (optics/depth.hpp, DisparitySurface::hit, the same search in
 // float): each ray shows the view where it meets the content's surface rather than the flat screen.
-// Included by elemental.frag (NELF_DEPTH, NELF_DEPTH_MAP) and elemental_depth_lookup.frag.
+// Included by elemental.frag (NELF_DEPTH, NELF_DEPTH_MAP, NELF_DEPTH_HITS) and elemental_depth_lookup.frag.
 layout(binding = 2) uniform sampler2D u_disparity;  // R32F: δ / W per map texel, unknown ones filled
 layout(location = 1) uniform vec2 u_parallax_gain;  // uv shift per mm of pupil crossing per unit of δ / W
 layout(location = 2) uniform vec2 u_disparity_range;  // back (smallest), front (largest) δ / W
@@ -13,11 +13,11 @@ float surface_disparity(vec2 uv) {
   return texelFetch(u_disparity, clamp(ivec2(floor(uv * vec2(size))), ivec2(0), size - 1), 0).r;
 }
 
-// The front-most crossing of the ray (meeting the flat screen at flat_uv, shifted by gain per unit
-// of δ / W) with the surface.
-vec2 surface_uv(vec2 flat_uv, vec2 gain) {
+// The δ / W of the front-most crossing of the ray (meeting the flat screen at flat_uv, shifted by
+// gain per unit of δ / W) with the surface.
+float surface_hit(vec2 flat_uv, vec2 gain) {
   const float back = u_disparity_range.x, front = u_disparity_range.y;
-  if (!(front > back) || surface_disparity(flat_uv + gain * front) >= front) return flat_uv + gain * front;
+  if (!(front > back) || surface_disparity(flat_uv + gain * front) >= front) return front;
   float hit = back, before = front;
   // optics/depth.hpp: depth_search_steps_for the texels the ray crosses.
   const vec2 size = vec2(textureSize(u_disparity, 0));
@@ -40,5 +40,8 @@ vec2 surface_uv(vec2 flat_uv, vec2 gain) {
     else
       before = mid;
   }
-  return flat_uv + gain * hit;
+  return hit;
 }
+
+// Where that ray shows the view.
+vec2 surface_uv(vec2 flat_uv, vec2 gain) { return flat_uv + gain * surface_hit(flat_uv, gain); }

@@ -3,13 +3,14 @@
 // optics/mapping.cpp (view_coordinate) in float. Pixel positions are taken relative to the
 // panel's pixel grid, so float keeps sub-micrometre precision.
 //
-// Compiled in six variants (compositor/gl/shader_programs.cpp lists them, and the build validates
+// Compiled in seven variants (compositor/gl/shader_programs.cpp lists them, and the build validates
 // each): as is for pass 1 (point samples over the whole region), with NELF_AREA_SAMPLE for the
 // border strips, NELF_COORDINATE_MAP for pass 1's coordinate map, NELF_AREA_SAMPLE +
 // NELF_RECORD_TAPS for the CPU composite table, NELF_DEPTH (with or without NELF_AREA_SAMPLE)
-// for pass 1 and the strips of the depth-aware composite, and NELF_DEPTH_MAP for its pass 1's
-// depth coordinate map (elemental_depth_lookup.frag). Compile-time switches: llvmpipe would otherwise
-// evaluate both sides of a run-time choice for every pixel.
+// for pass 1 and the strips of the depth-aware composite, NELF_DEPTH_MAP for its pass 1's
+// depth coordinate map (elemental_depth_lookup.frag), and NELF_AREA_SAMPLE + NELF_DEPTH_HITS for
+// the strips after that pass 1. Compile-time switches: llvmpipe would otherwise evaluate both sides
+// of a run-time choice for every pixel.
 //
 // Memory layout: row 0 of the target region is the top row of the eye image (as in nelf::Image);
 // the view textures likewise hold the image's top row first, so t (down) is the texture's y.
@@ -26,8 +27,29 @@ const int u_subsamples = NELF_SUBSAMPLES;
 
 out vec4 colour;
 
-#if defined(NELF_DEPTH) || defined(NELF_DEPTH_MAP)
+#if defined(NELF_DEPTH) || defined(NELF_DEPTH_MAP) || defined(NELF_DEPTH_HITS)
 #include "depth_search.glsl"
+#endif
+
+#ifdef NELF_DEPTH_HITS
+// The border strips after the depth-aware pass 1 from the depth coordinate map (fsaa 1). Each part
+// of a border pixel takes the crossing that pass 1 found for the nearest pixel seen through the same
+// lens, rather than searching again: this pixel for its own lens, the pixel one pixel beyond the
+// border for a neighbour's. The two rays leave the display less than two pixels apart through the
+// same lens, so they meet the screen within two footprints of each other, the scale the prefiltered
+// view is already averaged over; they find different crossings only at an edge of the content's
+// depth. Searching four times a border pixel cost as much as all of pass 1 on llvmpipe.
+layout(binding = 3) uniform sampler2D u_hits;  // R32F, panel-sized, written by elemental_depth_lookup.frag
+vec2 g_lattice_position;                       // of the fragment's centre
+
+float hit_through(ivec2 lens) {
+  const vec2 own = floor(g_lattice_position + 0.5);
+  const vec2 across = vec2(lens) - own;  // -1, 0 or 1 per axis
+  const vec2 one_pixel = u_pixel_pitch * u_to_lens_plane / u_lens_pitch;  // in lattice units
+  const vec2 beyond = mix(g_lattice_position, own + across * (0.5 + one_pixel), notEqual(across, vec2(0.0)));
+  const ivec2 size = textureSize(u_hits, 0);
+  return texelFetch(u_hits, clamp(ivec2(floor(lattice_to_pixel(beyond))), ivec2(0), size - 1), 0).r;
+}
 #endif
 
 bool inside(vec2 uv) { return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))); }
@@ -49,6 +71,8 @@ bool lens_coordinate(vec2 s, ivec2 lens, out vec2 uv) {
   uv = vec2((v.x - u_screen_centre.x) / u_screen_size.x + 0.5, 0.5 - (v.y - u_screen_centre.y) / u_screen_size.y);
 #ifdef NELF_DEPTH
   uv = surface_uv(uv, (c - (s - c) * u_pupil_per_lens) * u_parallax_gain);
+#elif defined(NELF_DEPTH_HITS)
+  uv += (c - (s - c) * u_pupil_per_lens) * u_parallax_gain * hit_through(lens);
 #endif
   return true;
 }
@@ -171,6 +195,9 @@ void main() {
   // Stratified sub-samples (1, 2×2 or 4×4). Pass 1 point-samples each; the border-strip pass
   // (border_strips.vert) area-samples each sub-aperture, splitting it between the lenses it overlaps.
   const vec2 pixel_corner = floor(gl_FragCoord.xy - u_region_origin);
+#ifdef NELF_DEPTH_HITS
+  g_lattice_position = lattice_position(display_position(pixel_corner + 0.5));
+#endif
   const float step_ = 1.0 / float(u_subsamples);
   vec3 sum = vec3(0.0);
   for (int sy = 0; sy < u_subsamples; ++sy) {

@@ -225,6 +225,7 @@ void GlCompositor::draw_depth_map(const EyeMapping& m, CoordinateMap& map) {
   map.fbo.reset();
   map.texture = gl::make_texture_2d(GL_RGBA32F, m.panel[0], m.panel[1]);
   map.fbo = gl::make_framebuffer(map.texture);
+  map.hits = gl::make_texture_2d(GL_R32F, m.panel[0], m.panel[1]);
   upload_mapping(m, TextureTransform{}, 0, 0);
   glProgramUniform1f(program(shaders::ProgramKind::depth_map), shaders::location::depth::pupil_per_lens,
                      f(m.eye_relief_mm / m.gap_mm));
@@ -298,8 +299,8 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
   if (depth) {
     const DisparitySurface& surface = *depth_[e].surface;
     const Vec2 gain = pupil_gain(depth_geometry(profile_, m), {1.0, 1.0});
-    for (shaders::ProgramKind kind :
-         {shaders::ProgramKind::depth, shaders::ProgramKind::depth_border, shaders::ProgramKind::depth_lookup}) {
+    for (shaders::ProgramKind kind : {shaders::ProgramKind::depth, shaders::ProgramKind::depth_border,
+                                      shaders::ProgramKind::depth_lookup, shaders::ProgramKind::depth_border_hits}) {
       namespace at = shaders::location::depth;
       glProgramUniform2f(program(kind), at::parallax_gain, f(gain.x), f(gain.y));
       glProgramUniform2f(program(kind), at::disparity_range, surface.back(), surface.front());
@@ -321,13 +322,21 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
   } else if (use_depth_map) {
     glBindSampler(shaders::second_unit, 0);
     glBindTextureUnit(shaders::second_unit, map.texture.id());
+    glBindImageTexture(shaders::hits_image_unit, map.hits.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glUseProgram(program(shaders::ProgramKind::depth_lookup));
   } else {
     glUseProgram(program(depth ? shaders::ProgramKind::depth : shaders::ProgramKind::elemental));
   }
   glDrawArrays(GL_TRIANGLES, 0, 3);
   if (border_strips) {
-    glUseProgram(program(depth ? shaders::ProgramKind::depth_border : shaders::ProgramKind::border));
+    if (use_depth_map) {  // the strips take pass 1's crossings (elemental.frag, NELF_DEPTH_HITS)
+      glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+      glBindSampler(shaders::hits_unit, 0);
+      glBindTextureUnit(shaders::hits_unit, map.hits.id());
+      glUseProgram(program(shaders::ProgramKind::depth_border_hits));
+    } else {
+      glUseProgram(program(depth ? shaders::ProgramKind::depth_border : shaders::ProgramKind::border));
+    }
     glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
   }
   gl::check_error("rendering an eye image");

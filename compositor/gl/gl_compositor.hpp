@@ -142,6 +142,7 @@ class GlCompositor final : public Compositor {
   struct CoordinateMap {
     gl::Texture texture;
     gl::Framebuffer fbo;
+    gl::Texture hits;  // depth maps: R32F, the crossing pass 1 found for each pixel
     int width = 0, height = 0;
     double aspect = 0.0;
   };

@@ -13,6 +13,8 @@ inline constexpr unsigned mapping_block_binding = 0;  // uniform block Mapping
 inline constexpr unsigned view_unit = 0;              // u_view (u_input in prefilter_box.frag)
 inline constexpr unsigned second_unit = 1;            // u_map (elemental_lookup.frag), u_label (text_overlay.frag)
 inline constexpr unsigned disparity_unit = 2;         // u_disparity (elemental.frag, NELF_DEPTH)
+inline constexpr unsigned hits_unit = 3;              // u_hits (elemental.frag, NELF_DEPTH_HITS)
+inline constexpr unsigned hits_image_unit = 0;        // image u_hits (elemental_depth_lookup.frag)
 
 // Uniform locations: `layout(location = N)`, per shader.
 namespace location {

@@ -57,7 +57,7 @@ TEST(DepthComposite, GlMatchesTheDepthAwareReferenceAndDiffersFromTheFlatScreen)
       "depth-aware GL vs depth-aware reference %.2f dB; flat GL vs it %.2f dB; the references differ by %.2f dB\n", db,
       flat_db, reference_shift);
   EXPECT_LT(reference_shift, 36.0) << "the near block must change the reference";
-  EXPECT_GE(db, 33.0);
+  EXPECT_GE(db, 43.7) << "border strips taking the flat screen's depth give 43.2 dB";
   EXPECT_GE(db - flat_db, 5.0) << "the depth-aware GL path must follow the surface";
 }
 

@@ -120,6 +120,13 @@ TEST(ShaderInterface, UniformLocationsAndTextureUnitsAreTheDeclaredOnes) {
     EXPECT_EQ(sampler_unit(depth.id(), "u_view"), static_cast<GLint>(shaders::view_unit));
     EXPECT_EQ(sampler_unit(depth.id(), "u_disparity"), static_cast<GLint>(shaders::disparity_unit));
   }
+  const gl::Program lookup_depth = link(ProgramKind::depth_lookup);
+  EXPECT_EQ(sampler_unit(lookup_depth.id(), "u_map"), static_cast<GLint>(shaders::second_unit));
+  EXPECT_EQ(sampler_unit(lookup_depth.id(), "u_hits"), static_cast<GLint>(shaders::hits_image_unit));
+  const gl::Program strips_from_hits = link(ProgramKind::depth_border_hits);
+  EXPECT_EQ(glGetUniformLocation(strips_from_hits.id(), "u_parallax_gain"), at::depth::parallax_gain);
+  EXPECT_EQ(glGetUniformLocation(strips_from_hits.id(), "u_pupil_per_lens"), at::depth::pupil_per_lens);
+  EXPECT_EQ(sampler_unit(strips_from_hits.id(), "u_hits"), static_cast<GLint>(shaders::hits_unit));
 
   const gl::Program text = link(ProgramKind::text_overlay);
   EXPECT_EQ(glGetUniformLocation(text.id(), "u_box_origin"), at::text_box_origin);
