@@ -73,25 +73,36 @@ float DisparitySurface::at(Vec2 uv) const {
 
 Vec2 DisparitySurface::hit(Vec2 flat_uv, Vec2 gain) const {
   const auto along = [&](double d) { return Vec2{flat_uv.x + gain.x * d, flat_uv.y + gain.y * d}; };
-  const auto meets = [&](double d) { return at(along(d)) >= d; };  // the ray is at or behind the surface
   const double front = front_, back = back_;
-  if (!(front > back) || meets(front)) return along(front);
-  double hit = back, before = front;
-  const double extent = (front - back) * std::max(std::abs(gain.x) * width_, std::abs(gain.y) * height_);
-  const int steps = depth_search_steps_for(extent);
-  for (int i = 1; i <= steps; ++i) {
-    const double d = front - (front - back) * i / steps;
-    if (meets(d)) {
-      hit = d;
-      break;
-    }
-    before = d;
+  if (!(front > back)) return along(front);
+  // A texel walk (Amanatides and Woo's): t = front − δ / W runs from 0 to the range; p is the ray's
+  // texel coordinate at the front, v how many texels it moves per unit of t along each axis.
+  const double range = front - back;
+  const double p[2] = {along(front).x * width_, along(front).y * height_};
+  const double v[2] = {-gain.x * width_, -gain.y * height_};
+  int texel[2], step[2];
+  double delta[2], next[2];
+  for (int a = 0; a < 2; ++a) {
+    texel[a] = static_cast<int>(std::floor(p[a]));
+    step[a] = v[a] > 0.0 ? 1 : v[a] < 0.0 ? -1 : 0;
+    const double speed = std::max(std::abs(v[a]), 1e-30);
+    delta[a] = 1.0 / speed;
+    next[a] = (v[a] > 0.0 ? std::floor(p[a]) + 1.0 - p[a] : p[a] - std::floor(p[a])) / speed;
   }
-  for (int k = 0; k < depth_search_bisections; ++k) {
-    const double mid = 0.5 * (hit + before);
-    (meets(mid) ? hit : before) = mid;
+  double t = 0.0;
+  for (int i = 0; i < depth_search_texels; ++i) {
+    const double t_next = std::min({next[0], next[1], range});
+    const double value = values_[static_cast<std::size_t>(std::clamp(texel[1], 0, height_ - 1)) * width_ +
+                                 std::clamp(texel[0], 0, width_ - 1)];
+    const double leave = t_next >= range ? back : front - t_next;
+    if (value >= leave) return along(std::min(value, front - t));
+    if (t_next >= range) break;
+    const int a = next[0] < next[1] ? 0 : 1;
+    texel[a] += step[a];
+    t = next[a];
+    next[a] += delta[a];
   }
-  return along(hit);
+  return along(back);
 }
 
 }  // namespace nelf

@@ -60,9 +60,10 @@ class DisparitySurface {
 
   // Where on the screen (uv) a ray shows the surface: the ray meets the flat screen at `flat_uv` and
   // shifts by `gain` (uv) per unit of δ / W (pupil_gain of its pupil-plane crossing). The front-most
-  // crossing, found by steps from the front to the back (depth_search_steps_for the texels the ray
-  // crosses) and a bisection of the step that crosses. A surface of one value v gives
-  // flat_uv + gain · v exactly (0: flat_uv).
+  // crossing, exact for the nearest-texel surface: the ray walks the texels it crosses from the front
+  // of the range to its back; in a texel of value v that it enters at δ / W = a and leaves at b < a
+  // it is at or behind the surface from v down, so it crosses at min(v, a) when v ≥ b. A surface of
+  // one value v gives flat_uv + gain · v exactly (0: flat_uv).
   Vec2 hit(Vec2 flat_uv, Vec2 gain) const;
 
  private:
@@ -72,18 +73,10 @@ class DisparitySurface {
   bool unknown_ = false;
 };
 
-// Steps of the search from front to back, and bisections of the crossing step (the shader's too).
-inline constexpr int depth_search_steps = 24;
-inline constexpr int depth_search_bisections = 3;
-
-// The steps a ray takes that crosses `extent_texels` texels of the map between the front and the
-// back of the range: two a texel, so that no texel is stepped over, and at most depth_search_steps.
-// A ray moves a few texels at most (its pupil-plane crossing is within half the eye box), so most
-// take far fewer than 24; the shader computes the same in float.
-inline int depth_search_steps_for(double extent_texels) {
-  const double steps = std::ceil(2.0 * extent_texels);
-  return steps >= depth_search_steps ? depth_search_steps : steps <= 2.0 ? 2 : static_cast<int>(steps);
-}
+// The most texels a ray's search visits (the shader's too): a ray moves by its pupil-plane crossing
+// over e times the frame's disparity range, a few texels of the map; past this many it is taken to
+// show the back of the range.
+inline constexpr int depth_search_texels = 48;
 
 // The uv shift per unit of δ / W of a ray crossing the pupil plane at `pupil_mm`: (p_x / e, −p_y W / (e H)).
 Vec2 pupil_gain(const DepthGeometry& g, Vec2 pupil_mm);

@@ -5,42 +5,43 @@ layout(binding = 2) uniform sampler2D u_disparity;  // R32F: δ / W per map texe
 layout(location = 1) uniform vec2 u_parallax_gain;  // uv shift per mm of pupil crossing per unit of δ / W
 layout(location = 2) uniform vec2 u_disparity_range;  // back (smallest), front (largest) δ / W
 layout(location = 3) uniform float u_pupil_per_lens;  // d_e / d_l: chief ray's pupil crossing = c − (s − c) · this
-const int depth_search_steps = 24;                   // optics/depth.hpp: depth_search_steps
-const int depth_search_bisections = 3;               // and depth_search_bisections
-
-float surface_disparity(vec2 uv) {
-  const ivec2 size = textureSize(u_disparity, 0);
-  return texelFetch(u_disparity, clamp(ivec2(floor(uv * vec2(size))), ivec2(0), size - 1), 0).r;
-}
+const int depth_search_texels = 48;                  // optics/depth.hpp: depth_search_texels
 
 // The δ / W of the front-most crossing of the ray (meeting the flat screen at flat_uv, shifted by
-// gain per unit of δ / W) with the surface.
+// gain per unit of δ / W) with the surface: the ray walks the map's texels from the front of the
+// range to its back; in a texel of value v that it enters at δ / W = a and leaves at b < a, it is at
+// or behind the surface from v down, so it crosses there (at min(v, a)) when v >= b. One fetch a
+// texel crossed; steps of half a texel and a bisection of the crossing one took three times as many.
 float surface_hit(vec2 flat_uv, vec2 gain) {
   const float back = u_disparity_range.x, front = u_disparity_range.y;
-  if (!(front > back) || surface_disparity(flat_uv + gain * front) >= front) return front;
-  float hit = back, before = front;
-  // optics/depth.hpp: depth_search_steps_for the texels the ray crosses.
-  const vec2 size = vec2(textureSize(u_disparity, 0));
-  const float extent = (front - back) * max(abs(gain.x) * size.x, abs(gain.y) * size.y);
-  const float wanted = ceil(2.0 * extent);
-  const int steps = wanted >= float(depth_search_steps) ? depth_search_steps : wanted <= 2.0 ? 2 : int(wanted);
-  for (int i = 1; i <= depth_search_steps; ++i) {  // a constant bound (llvmpipe), left at `steps`
-    if (i > steps) break;
-    const float d = front - (front - back) * float(i) / float(steps);
-    if (surface_disparity(flat_uv + gain * d) >= d) {
-      hit = d;
-      break;
+  if (!(front > back)) return front;
+  const ivec2 size = textureSize(u_disparity, 0);
+  const float range = front - back;
+  const vec2 p = (flat_uv + gain * front) * vec2(size);  // texel coordinate at the front
+  const vec2 v = -gain * vec2(size);                      // texels per unit of (front − δ / W)
+  ivec2 texel = ivec2(floor(p));
+  const ivec2 step_ = ivec2(sign(v));
+  const vec2 speed = max(abs(v), vec2(1.0e-30));
+  const vec2 delta = 1.0 / speed;
+  vec2 next = mix(p - floor(p), floor(p) + 1.0 - p, greaterThan(v, vec2(0.0))) / speed;
+  float t = 0.0;
+  for (int i = 0; i < depth_search_texels; ++i) {
+    const float t_next = min(min(next.x, next.y), range);
+    const float value = texelFetch(u_disparity, clamp(texel, ivec2(0), size - 1), 0).r;
+    const float leave = t_next >= range ? back : front - t_next;
+    if (value >= leave) return min(value, front - t);
+    if (t_next >= range) break;
+    if (next.x < next.y) {
+      texel.x += step_.x;
+      t = next.x;
+      next.x += delta.x;
+    } else {
+      texel.y += step_.y;
+      t = next.y;
+      next.y += delta.y;
     }
-    before = d;
   }
-  for (int k = 0; k < depth_search_bisections; ++k) {
-    const float mid = 0.5 * (hit + before);
-    if (surface_disparity(flat_uv + gain * mid) >= mid)
-      hit = mid;
-    else
-      before = mid;
-  }
-  return hit;
+  return back;
 }
 
 // Where that ray shows the view.

@@ -94,10 +94,34 @@ TEST(DisparitySurface, TheFrontMostCrossingWins) {
   const Vec2 near_hit = s.hit({0.51, 0.5}, gain);    // at δ = 0.4 the ray is at u = 0.49: near half
   EXPECT_NEAR(near_hit.x, 0.51 - 0.05 * 0.4, 1e-7);  // δ/W is a float
   const Vec2 far_hit = s.hit({0.9, 0.5}, gain);
-  EXPECT_NEAR(far_hit.x, 0.9, 0.05 * 0.4 / depth_search_steps / 32);
+  EXPECT_DOUBLE_EQ(far_hit.x, 0.9);
   // From the other side the near half's edge hides nothing: the ray meets the far plane.
   const Vec2 right_eye = s.hit({0.51, 0.5}, {0.05, 0.0});
-  EXPECT_NEAR(right_eye.x, 0.51, 0.05 * 0.4 / depth_search_steps / 32);
+  EXPECT_DOUBLE_EQ(right_eye.x, 0.51);
+}
+
+// The crossing is exact for the nearest-texel surface: on a texel's top where the ray meets its
+// value inside it, on its side where the ray enters it below its value.
+TEST(DisparitySurface, TheCrossingIsWhereTheRayMeetsTheTexels) {
+  ViewDisparity d{100, 10, std::vector<float>(1000, 0.f)};
+  for (int y = 0; y < 10; ++y) {
+    for (int x = 40; x < 60; ++x) d.d[static_cast<std::size_t>(y) * 100 + x] = 5.f;  // δ/W 0.05
+    for (int x = 0; x < 10; ++x) d.d[static_cast<std::size_t>(y) * 100 + x] = 10.f;  // the front, 0.1
+  }
+  const DisparitySurface s(d);
+  const double top = s.values()[50];
+  // Within texel 50 from the front (0.1) to the back (0): met at the texel's value.
+  const Vec2 on_top = s.hit({0.505, 0.55}, {0.01, 0.0});
+  EXPECT_NEAR(on_top.x, 0.505 + 0.01 * top, 1e-15);
+  EXPECT_EQ(on_top.y, 0.55);
+  // From u = 0.36 at the front to 0.41 at the back: it reaches the block's side (u = 0.40) at
+  // δ/W = 0.02, below the block's 0.05, and shows the side there.
+  const Vec2 on_side = s.hit({0.41, 0.55}, {-0.5, 0.0});
+  EXPECT_NEAR(on_side.x, 0.40, 1e-12);
+  // Diagonally through texel corners: the same wall, met where the ray reaches it.
+  const Vec2 diagonal = s.hit({0.41, 0.55}, {-0.5, -0.5});
+  EXPECT_NEAR(diagonal.x, 0.40, 1e-12);
+  EXPECT_NEAR(diagonal.y, 0.55 - 0.5 * 0.02, 1e-12);
 }
 
 }  // namespace
