@@ -21,9 +21,8 @@ float surface_hit(vec2 flat_uv, vec2 gain) {
   const vec2 v = -gain * vec2(size);                      // texels per unit of (front − δ / W)
   ivec2 texel = ivec2(floor(p));
   const ivec2 step_ = ivec2(sign(v));
-  const vec2 speed = max(abs(v), vec2(1.0e-30));
-  const vec2 delta = 1.0 / speed;
-  vec2 next = mix(p - floor(p), floor(p) + 1.0 - p, greaterThan(v, vec2(0.0))) / speed;
+  const vec2 delta = 1.0 / max(abs(v), vec2(1.0e-30));
+  vec2 next = mix(p - floor(p), floor(p) + 1.0 - p, greaterThan(v, vec2(0.0))) * delta;
   float t = 0.0;
   for (int i = 0; i < depth_search_texels; ++i) {
     const float t_next = min(min(next.x, next.y), range);

@@ -16,19 +16,18 @@ layout(binding = 0, r32f) uniform writeonly image2D u_hits;  // panel-sized: eac
 out vec4 colour;
 
 void main() {
+  // One path for every pixel: llvmpipe runs both sides of a branch under a mask, so an early return
+  // for the display's black pixels would only add a second image store.
   const ivec2 pixel = ivec2(gl_FragCoord.xy - u_region_origin);
   const vec4 ray = texelFetch(u_map, pixel, 0);
-  if (ray.x < -1.0e8) {  // a black pixel of the display
-    imageStore(u_hits, pixel, vec4(0.0));
-    colour = vec4(0.0, 0.0, 0.0, 1.0);
-    return;
-  }
+  const bool black = ray.x < -1.0e8;  // a black pixel of the display
   const vec2 gain = ray.zw * u_parallax_gain;
   const float hit = surface_hit(ray.xy, gain);
   imageStore(u_hits, pixel, vec4(hit));
   const vec2 uv = ray.xy + gain * hit;
   const bool outside = any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)));
-  colour = vec4(u_cut_outside != 0 && outside ? vec3(0.0)
-                                              : textureLod(u_view, uv * u_texture_scale + u_texture_offset, 0.0).rgb,
+  colour = vec4(black || (u_cut_outside != 0 && outside)
+                    ? vec3(0.0)
+                    : textureLod(u_view, uv * u_texture_scale + u_texture_offset, 0.0).rgb,
                 1.0);
 }
