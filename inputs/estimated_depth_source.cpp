@@ -25,6 +25,10 @@ class EstimatedDepthSource final : public Source {
   std::vector<AudioTrack> audio_tracks() const override { return source_->audio_tracks(); }
   std::unique_ptr<CarriedStreams> open_carried_streams() const override { return source_->open_carried_streams(); }
   std::int64_t lost_frames() const override { return source_->lost_frames(); }
+  void interrupt() override { source_->interrupt(); }
+  void refresh_at(std::int64_t refresh_ns, std::int64_t period_ns) override {
+    source_->refresh_at(refresh_ns, period_ns);
+  }
 
  private:
   std::unique_ptr<Source> source_;

@@ -8,6 +8,8 @@
 #include <sys/time.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstring>
@@ -174,11 +176,25 @@ class GlxStereoSource final : public Source {
       // Overwritten while copied: the game drew faster than nelf reads, and its next frame is newer
       // anyway. Not a lost frame (the play summary's "lost to decode errors"), any more than the
       // older frames passed over above: like every live source, this one shows the newest.
-      if (std::optional<StereoVideoFrame> frame = copy(*newest)) return frame;
+      if (std::optional<StereoVideoFrame> frame = copy(*newest)) {
+        note_lead(frame->captured_ns - newest->swapped_ns);
+        return frame;
+      }
     }
   }
 
   void interrupt() override { interrupted_ = true; }
+
+  // Passed on to the interposer (protocol: refresh); a message the game has no room for is dropped,
+  // the next refresh says the same.
+  void refresh_at(std::int64_t refresh_ns, std::int64_t period_ns) override {
+    protocol::Message message;
+    message.type = protocol::MessageType::refresh;
+    message.refresh_ns = refresh_ns;
+    message.period_ns = period_ns;
+    message.lead_ns = lead_ns_.load();
+    ::send(link_.get(), &message, sizeof message, MSG_NOSIGNAL | MSG_DONTWAIT);
+  }
 
   ViewFormat negotiate(const ViewFormat& wanted) override {
     const auto& [bx, by] = wanted.block;
@@ -188,6 +204,14 @@ class GlxStereoSource final : public Source {
   }
 
  private:
+  // How long before a refresh the game must swap a frame for nelf to have read it (refresh_at):
+  // the longest of the last 16 frames' swap-to-read times, and a millisecond.
+  void note_lead(std::int64_t swap_to_read_ns) {
+    recent_[recent_count_++ % recent_.size()] = std::max<std::int64_t>(swap_to_read_ns, 0);
+    const std::size_t n = std::min(recent_count_, recent_.size());
+    lead_ns_ = *std::max_element(recent_.begin(), recent_.begin() + static_cast<std::ptrdiff_t>(n)) + 1'000'000;
+  }
+
   std::optional<StereoVideoFrame> copy(const protocol::Message& message) {
     const auto w = static_cast<std::uint32_t>(width_), h = static_cast<std::uint32_t>(height_);
     unsigned char* slot = shared_.get() + message.slot * protocol::slot_stride(w, h);
@@ -271,6 +295,9 @@ class GlxStereoSource final : public Source {
   std::string description_;
   std::atomic<bool> interrupted_{false};
   std::array<int, 2> block_{1, 1};
+  std::array<std::int64_t, 16> recent_{};  // note_lead: the last frames' swap-to-read times
+  std::size_t recent_count_ = 0;
+  std::atomic<std::int64_t> lead_ns_{0};  // written by next()'s thread, read by refresh_at()'s
 };
 
 }  // namespace

@@ -8,7 +8,14 @@
 // of kSlots frame slots attached (SCM_RIGHTS), or mono (then it closes: nelf captures the window).
 // Then one frame message per swap, naming the slot just written. nelf may answer once with
 // want_depth (it composites with the game's depth, `--depth auto`): from then on each slot also
-// holds both eyes' depth buffers. The slots are written in turn and
+// holds both eyes' depth buffers. While nelf shows the frames on a display that refreshes at a fixed
+// rate (play, run) it sends a refresh message at each refresh: its time, the period, and how long
+// before a refresh a swapped frame must be to be in it (nelf's read of the last frames, and a
+// margin). A game that asks for a swap interval of N (glXSwapInterval*, 1 when it never asks, as
+// GLX has it) then has each buffer swap return so that its next frame, drawn in the time its last
+// one took, is swapped that long before a refresh, N refreshes on: it is shown at the first refresh
+// it can be, as vsync does on a monitor, and no later.
+// The slots are written in turn and
 // guarded by a sequence number (odd while written), so that a reader that fell behind notices a slot
 // overwritten under it instead of showing a torn frame; the game never waits for nelf.
 #include <cstddef>
@@ -16,11 +23,11 @@
 
 namespace nelf::glx_stereo {
 
-inline constexpr std::uint32_t kMagic = 0x4e4c4632;  // "NLF2"
+inline constexpr std::uint32_t kMagic = 0x4e4c4633;  // "NLF3"
 inline constexpr int kSlots = 3;
 inline constexpr const char* kSocketVariable = "NELF_GLX_STEREO_SOCKET";
 
-enum class MessageType : std::uint32_t { hello = 1, frame = 2, want_depth = 3 };
+enum class MessageType : std::uint32_t { hello = 1, frame = 2, want_depth = 3, refresh = 4 };
 
 struct Message {
   std::uint32_t magic = kMagic;
@@ -31,8 +38,11 @@ struct Message {
   std::uint32_t slot = 0;       // frame: the slot just written
   std::uint64_t frame = 0;      // frame: the game's swap count, from 0
   std::int64_t swapped_ns = 0;  // frame: CLOCK_MONOTONIC when the game asked to swap
+  std::int64_t refresh_ns = 0;  // refresh: CLOCK_MONOTONIC when one of nelf's refreshes began
+  std::int64_t period_ns = 0;   // refresh: the time from one to the next
+  std::int64_t lead_ns = 0;     // refresh: a frame swapped this long before a refresh is shown in it
 };
-static_assert(sizeof(Message) == 40);
+static_assert(sizeof(Message) == 64);
 
 // The head of each slot; the left eye's RGBA rows follow at kSlotHeader, then the right eye's, each
 // width × height × 4 bytes, then, when `depth` is 1, the left and the right eye's depth buffers as

@@ -92,6 +92,11 @@ class Source {
   // frame as long as nothing changes: a next() waiting returns nullopt within 0.1 s, and every
   // later one at once. Sources that never wait ignore it.
   virtual void interrupt() {}
+  // From play's thread, at each refresh of a display that refreshes at a fixed rate: it began at
+  // `refresh_ns` (CLOCK_MONOTONIC) and the next begins `period_ns` later. A live source that can
+  // time its frames to it passes it on (glx-stereo: the game's buffer swaps return at nelf's
+  // refreshes, as vsync does); the others ignore it.
+  virtual void refresh_at(std::int64_t /*refresh_ns*/, std::int64_t /*period_ns*/) {}
 };
 
 }  // namespace nelf

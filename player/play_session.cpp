@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cstdio>
 
 #include "compositor/overlays/subtitle_overlay.hpp"
@@ -144,10 +145,17 @@ double PlaySession::seen_after() const {
 }
 
 void PlaySession::wait_for_next_refresh() {
-  if (options.clock)
+  if (options.clock) {
     options.clock->advance(refresh_period);
-  else if (!display.vsync())
-    ticker.sleep_to_next();
+    return;
+  }
+  if (!display.vsync()) ticker.sleep_to_next();
+  // A refresh begins (with vsync, present() returned at it): a live source may time its frames to
+  // it (a quad-buffer game's swaps).
+  using namespace std::chrono;
+  const auto refresh = display.vsync() ? steady_clock::now() : ticker.tick();
+  source.refresh_at(duration_cast<nanoseconds>(refresh.time_since_epoch()).count(),
+                    duration_cast<nanoseconds>(duration<double>(refresh_period)).count());
 }
 
 PlayResult PlaySession::finish(std::int64_t composited_ahead) {

@@ -40,6 +40,8 @@ class RefreshTicker {
     if (next_ < now - std::chrono::milliseconds(100)) next_ = now;  // far behind: do not race
     std::this_thread::sleep_until(next_);
   }
+  // The refresh sleep_to_next() slept to (it returns late when the loop overran it).
+  Steady::time_point tick() const { return next_; }
 
  private:
   Steady::duration period_;

@@ -30,16 +30,20 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "inputs/glx_stereo_protocol.hpp"
@@ -177,19 +181,38 @@ class NelfLink {
     send(message, -1);
   }
 
-  // Whether nelf asked for the depth buffers (it composites with the game's depth): read without
-  // waiting, once asked always.
-  bool depth_wanted() {
-    if (depth_wanted_ || fd_ < 0) return depth_wanted_;
+  // What nelf said since the last call, read without waiting: whether it wants the depth buffers
+  // (it composites with the game's depth; once asked, always), and its newest refresh.
+  void read_messages() {
     protocol::Message message;
-    const ssize_t n = ::recv(fd_, &message, sizeof message, MSG_DONTWAIT);
-    depth_wanted_ = n == static_cast<ssize_t>(sizeof message) && message.magic == protocol::kMagic &&
-                    message.type == protocol::MessageType::want_depth;
-    return depth_wanted_;
+    while (fd_ >= 0 && ::recv(fd_, &message, sizeof message, MSG_DONTWAIT) == static_cast<ssize_t>(sizeof message)) {
+      if (message.magic != protocol::kMagic) continue;
+      if (message.type == protocol::MessageType::want_depth) depth_wanted_ = true;
+      if (message.type == protocol::MessageType::refresh && message.period_ns > 0) {
+        refresh_ns_ = message.refresh_ns;
+        period_ns_ = message.period_ns;
+        lead_ns_ = std::clamp<std::int64_t>(message.lead_ns, 0, message.period_ns);
+      }
+    }
+  }
+  bool depth_wanted() const { return depth_wanted_; }
+  bool linked_for_stereo() const { return fd_ >= 0 && shared_ != nullptr; }
+
+  // When a swap made at `now` with swap interval `interval` returns, for a game that takes
+  // `game_ns` to draw a frame: so that the next frame is swapped nelf's lead before the first of
+  // its refreshes it can reach, interval − 1 refreshes on; 0 (at once) for interval 0, or when nelf
+  // has said no refresh in the last half second (convert, or a display that stopped).
+  std::int64_t swap_returns_ns(std::int64_t now, int interval, std::int64_t game_ns) const {
+    if (interval <= 0 || period_ns_ <= 0 || now - refresh_ns_ > 500'000'000) return 0;
+    const std::int64_t early = lead_ns_ + std::clamp<std::int64_t>(game_ns, 0, period_ns_);
+    const std::int64_t since = now + early - refresh_ns_;  // the refresh reached: the first at or after now + early
+    const std::int64_t refreshes = since <= 0 ? 0 : (since + period_ns_ - 1) / period_ns_;
+    return refresh_ns_ + (refreshes + interval - 1) * period_ns_ - early;
   }
 
   void close() {
     depth_wanted_ = false;
+    period_ns_ = 0;
     if (shared_) munmap(shared_, bytes_);
     shared_ = nullptr;
     if (fd_ >= 0) ::close(fd_);
@@ -224,6 +247,8 @@ class NelfLink {
 
   int fd_ = -1;
   bool depth_wanted_ = false;
+  std::int64_t refresh_ns_ = 0, period_ns_ = 0;  // nelf's newest refresh, and its period (0: none said)
+  std::int64_t lead_ns_ = 0;
   unsigned char* shared_ = nullptr;
   std::size_t bytes_ = 0;
   std::uint32_t width_ = 0, height_ = 0;
@@ -244,6 +269,8 @@ struct Eyes {
   GLuint immediate_list = 0;    // glBegin … glEnd into both eyes: recorded here, then called twice
   bool recording_immediate = false;
   std::uint64_t swaps = 0;
+  std::int64_t returned_ns = 0;  // when the last swap returned to the game (0: none yet)
+  bool window_unpaced = false;   // the driver's swap interval set to 0: nelf's refreshes pace the game
   NelfLink link;
 };
 
@@ -258,6 +285,54 @@ bool g_said_mono = false;
 int g_mono_swaps = 0;
 std::int64_t g_first_swap_ns = 0;
 NelfLink g_verdict;
+
+// Swap control (GLX_EXT_swap_control, GLX_MESA_swap_control, GLX_SGI_swap_control) against nelf's
+// display, offered whether or not the driver has it (Mesa on Xvfb has none): the interval the game
+// asked for, 1 until it asks (GLX's default).
+std::atomic<int> g_swap_interval{1};
+constexpr const char* kSwapControl[] = {"GLX_EXT_swap_control", "GLX_MESA_swap_control", "GLX_SGI_swap_control"};
+
+bool lists(const char* extensions, std::string_view name) {
+  const std::string_view all = extensions ? extensions : "";
+  for (std::size_t at = all.find(name); at != std::string_view::npos; at = all.find(name, at + 1)) {
+    const std::size_t end = at + name.size();
+    if ((at == 0 || all[at - 1] == ' ') && (end == all.size() || all[end] == ' ')) return true;
+  }
+  return false;
+}
+
+// The driver's own swap interval for the game's window, where the driver has swap control.
+void driver_swap_interval(Display* dpy, GLXDrawable drawable, int interval) {
+  NELF_REAL_GLX(glXQueryExtensionsString);
+  NELF_REAL_GLX(glXGetCurrentDisplay);
+  if (!dpy) dpy = real_glXGetCurrentDisplay();
+  if (!dpy || !real_glXQueryExtensionsString) return;
+  const char* extensions = real_glXQueryExtensionsString(dpy, DefaultScreen(dpy));
+  using Ext = void (*)(Display*, GLXDrawable, int);
+  using Mesa = int (*)(unsigned int);
+  using Sgi = int (*)(int);
+  if (lists(extensions, kSwapControl[0]) && drawable) {
+    if (const auto f = real_gl<Ext>("glXSwapIntervalEXT")) f(dpy, drawable, interval);
+  } else if (lists(extensions, kSwapControl[1])) {
+    if (const auto f = real_gl<Mesa>("glXSwapIntervalMESA")) f(static_cast<unsigned int>(interval));
+  } else if (lists(extensions, kSwapControl[2]) && interval > 0) {
+    if (const auto f = real_gl<Sgi>("glXSwapIntervalSGI")) f(interval);
+  }
+}
+
+// The game's interval, kept for glXSwapBuffers and given to the driver, except for a window whose
+// swaps nelf's refreshes pace (the driver's vsync to the desktop's monitor would add its own wait).
+void set_swap_interval(Display* dpy, GLXDrawable drawable, int interval) {
+  g_swap_interval = interval;
+  const Eyes* e = t_current;
+  driver_swap_interval(dpy, drawable, e && e->window_unpaced ? 0 : interval);
+}
+
+void sleep_until_ns(std::int64_t t) {
+  timespec ts{static_cast<time_t>(t / 1000000000LL), static_cast<long>(t % 1000000000LL)};
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
 
 // This thread's context is now `context`, drawing into `drawable` (both make-current calls).
 void made_current(Display* display, GLXDrawable drawable, GLXContext context) {
@@ -393,6 +468,7 @@ void send_eyes(Eyes& e, std::int64_t swapped_ns) {
     real_glBindFramebuffer(GL_READ_FRAMEBUFFER, e.fbo[i]);
     real_glReadPixels(0, 0, e.width, e.height, GL_RGBA, GL_UNSIGNED_BYTE, slot + protocol::kSlotHeader + i * eye_bytes);
   }
+  e.link.read_messages();
   const bool depth = e.link.depth_wanted();
   for (int i = 0; depth && i < 2; ++i) {
     real_glBindFramebuffer(GL_READ_FRAMEBUFFER, e.fbo[i]);
@@ -595,7 +671,23 @@ __attribute__((visibility("default"))) void glXSwapBuffers(Display* dpy, GLXDraw
   const std::int64_t swapped_ns = monotonic_ns();
   send_eyes(*e, swapped_ns);
   show_left_eye(*e);
+  const int interval = g_swap_interval.load();
+  const std::int64_t game_ns = e->returned_ns != 0 ? swapped_ns - e->returned_ns : 0;  // its last frame's drawing
+  const bool paced = interval > 0 && e->link.linked_for_stereo();
+  if (paced && !e->window_unpaced) {
+    driver_swap_interval(dpy, drawable, 0);
+    e->window_unpaced = true;
+  }
   real_glXSwapBuffers(dpy, drawable);
+  // With a swap interval the swap returns in time for nelf's refresh (protocol: refresh), as vsync
+  // would; until nelf's display says its refreshes (play starting; convert has none), at 60 Hz.
+  std::int64_t returns = 0;
+  if (paced) {
+    const std::int64_t now = monotonic_ns();
+    returns = e->link.swap_returns_ns(now, interval, game_ns);
+    constexpr std::int64_t kUntilToldNs = 16'666'667;
+    if (returns == 0 && e->returned_ns != 0) returns = std::max(now, e->returned_ns + interval * kUntilToldNs);
+  }
   ++e->swaps;
   // A resized window: the eyes follow, and nelf is told the new size on a new link.
   int width = 0, height = 0;
@@ -605,6 +697,51 @@ __attribute__((visibility("default"))) void glXSwapBuffers(Display* dpy, GLXDraw
   }
   bind_draw(*e);
   bind_read(*e);
+  if (returns != 0) sleep_until_ns(returns);
+  e->returned_ns = monotonic_ns();
+}
+
+__attribute__((visibility("default"))) void glXSwapIntervalEXT(Display* dpy, GLXDrawable drawable, int interval) {
+  set_swap_interval(dpy, drawable, interval < 0 ? -interval : interval);  // < 0: adaptive, as vsync here
+}
+
+__attribute__((visibility("default"))) int glXSwapIntervalMESA(unsigned int interval) {
+  set_swap_interval(nullptr, 0, static_cast<int>(interval));
+  return 0;
+}
+
+__attribute__((visibility("default"))) int glXSwapIntervalSGI(int interval) {
+  if (interval <= 0) return GLX_BAD_VALUE;
+  set_swap_interval(nullptr, 0, interval);
+  return 0;
+}
+
+__attribute__((visibility("default"))) int glXGetSwapIntervalMESA() { return g_swap_interval.load(); }
+
+__attribute__((visibility("default"))) void glXQueryDrawable(Display* dpy, GLXDrawable drawable, int attribute,
+                                                             unsigned int* value) {
+  NELF_REAL_GLX(glXQueryDrawable);
+  if (attribute == GLX_SWAP_INTERVAL_EXT)
+    *value = static_cast<unsigned int>(g_swap_interval.load());
+  else if (attribute == GLX_MAX_SWAP_INTERVAL_EXT)
+    *value = 8;
+  else if (real_glXQueryDrawable)
+    real_glXQueryDrawable(dpy, drawable, attribute, value);
+}
+
+// The driver's extensions and swap control (above).
+__attribute__((visibility("default"))) const char* glXQueryExtensionsString(Display* dpy, int screen) {
+  NELF_REAL_GLX(glXQueryExtensionsString);
+  const char* real = real_glXQueryExtensionsString ? real_glXQueryExtensionsString(dpy, screen) : nullptr;
+  std::lock_guard lock(g_mutex);
+  static std::map<std::pair<Display*, int>, std::string> answers;  // nodes stay put: the pointers hold
+  std::string& answer = answers[{dpy, screen}];
+  if (answer.empty()) {
+    answer = real ? real : "";
+    for (const char* name : kSwapControl)
+      if (!lists(real, name)) answer += answer.empty() ? std::string(name) : " " + std::string(name);
+  }
+  return answer.c_str();
 }
 
 __attribute__((visibility("default"))) void glDrawBuffer(GLenum buffer) {
@@ -801,6 +938,12 @@ void* interposed(const char* name) {
       {"glXMakeContextCurrent", reinterpret_cast<void*>(&glXMakeContextCurrent)},
       {"glXDestroyContext", reinterpret_cast<void*>(&glXDestroyContext)},
       {"glXSwapBuffers", reinterpret_cast<void*>(&glXSwapBuffers)},
+      {"glXSwapIntervalEXT", reinterpret_cast<void*>(&glXSwapIntervalEXT)},
+      {"glXSwapIntervalMESA", reinterpret_cast<void*>(&glXSwapIntervalMESA)},
+      {"glXSwapIntervalSGI", reinterpret_cast<void*>(&glXSwapIntervalSGI)},
+      {"glXGetSwapIntervalMESA", reinterpret_cast<void*>(&glXGetSwapIntervalMESA)},
+      {"glXQueryDrawable", reinterpret_cast<void*>(&glXQueryDrawable)},
+      {"glXQueryExtensionsString", reinterpret_cast<void*>(&glXQueryExtensionsString)},
       {"glXGetProcAddress", reinterpret_cast<void*>(&glXGetProcAddress)},
       {"glXGetProcAddressARB", reinterpret_cast<void*>(&glXGetProcAddressARB)},
       {"glDrawBuffer", reinterpret_cast<void*>(&glDrawBuffer)},
