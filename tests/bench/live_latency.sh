@@ -14,6 +14,8 @@
 # With LATENCY_ARGS="…" more options go to nelf run (e.g. "--fsaa 0", "--profile lvt-prototype").
 # LATENCY_MODE=quad-buffer runs the game in quad-buffer stereo (its eyes through nelf's interposer)
 # instead of side by side in its window (sbs, the default; any mode of the test game).
+# LATENCY_VSYNC=1 has the game ask for vsync (--swap-interval 60/fps) instead of sleeping to its
+# rate: a quad-buffer game's swaps then return at nelf's refreshes, as on a monitor.
 set -euo pipefail
 build=$(realpath "${1:-build}")
 seconds=${2:-10}
@@ -35,10 +37,12 @@ export DISPLAY=":$display"
 
 echo "game fps | nelf shown | latency median ms | latency p99 ms | game frames shown"
 for fps in 30 60; do
+  pacing=()
+  [ -n "${LATENCY_VSYNC:-}" ] && pacing=(--swap-interval $((60 / fps)))
   # shellcheck disable=SC2086
   "$build/nelf" run --output "$output" --quiet --log-frames "$work/nelf$fps.csv" ${LATENCY_ARGS:-} -- \
     "$build/tests/nelf-test-game" --mode "${LATENCY_MODE:-sbs}" --size 1280x720 --fps "$fps" --duration "$seconds" \
-    --log "$work/game$fps.csv" 2>"$work/err$fps.txt" || { cat "$work/err$fps.txt" >&2; exit 1; }
+    "${pacing[@]}" --log "$work/game$fps.csv" 2>"$work/err$fps.txt" || { cat "$work/err$fps.txt" >&2; exit 1; }
   summary=$(tail -1 "$work/err$fps.txt")
   # Latency: nelf's present minus the game's, for each game frame when nelf first showed it. Share:
   # the distinct game frames shown among those the game presented from the first shown to the last.

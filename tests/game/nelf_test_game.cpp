@@ -7,7 +7,7 @@
 //   nelf-test-game [--toolkit glfw|sdl2] [--mode sbs|sbs-half|tab|tab-half|fp|quad-buffer]
 //                  [--fps N] [--size WxH] [--frames N] [--duration S] [--title T] [--log FILE]
 //                  [--reopen-after N] [--exit-status N] [--scene bars|planes]
-//                  [--hud arrays|immediate|list|bitmap|copy]
+//                  [--hud arrays|immediate|list|bitmap|copy] [--swap-interval N]
 //
 // --size is one eye's size (default 1280x720); the window is sized from it and the mode (fp: the
 // frame-packed window of that eye size, 1280x720 → 1280x1470). The game follows its window's size
@@ -19,7 +19,9 @@
 // the flat bars, two textured planes in perspective with a depth buffer, as a 3D game does
 // (planes_scene.hpp), for the tests of the game's depth. --hud (quad-buffer only) draws a HUD over
 // both eyes at once with glDrawBuffer(GL_BACK), with glDrawArrays, glBegin/glEnd, a display list,
-// glBitmap or glCopyPixels (hud.hpp).
+// glBitmap or glCopyPixels (hud.hpp). --swap-interval N (default 0) asks the toolkit for vsync
+// every N refreshes and lets the buffer swaps pace the game instead of sleeping to --fps (which
+// still sets the animation's speed): under `nelf run`, nelf's display refreshes pace it.
 // epoxy before the toolkits' headers, which would include GL/gl.h.
 #include <epoxy/gl.h>
 
@@ -68,6 +70,7 @@ struct Options {
   int exit_status = 0;
   bool planes = false;  // --scene planes
   Hud hud = Hud::none;
+  int swap_interval = 0;  // 0: the game sleeps to --fps; N: the swaps pace it
 };
 
 class BadUsage : public std::runtime_error {
@@ -159,6 +162,10 @@ Options parse(int argc, char** argv) {
       const double v = number(a, value());
       if (v < 1 || v != std::floor(v)) throw BadUsage("--reopen-after must be a whole number ≥ 1");
       o.reopen_after = static_cast<long>(v);
+    } else if (a == "--swap-interval") {
+      const double v = number(a, value());
+      if (v < 0 || v > 8 || v != std::floor(v)) throw BadUsage("--swap-interval must be 0..8");
+      o.swap_interval = static_cast<int>(v);
     } else if (a == "--exit-status") {
       const double v = number(a, value());
       if (v < 0 || v > 125 || v != std::floor(v)) throw BadUsage("--exit-status must be 0..125");
@@ -168,7 +175,7 @@ Options parse(int argc, char** argv) {
           "nelf-test-game [--toolkit glfw|sdl2] [--mode sbs|sbs-half|tab|tab-half|fp|quad-buffer] [--fps N]\n"
           "               [--size WxH] [--frames N] [--duration S] [--title T] [--log FILE]\n"
           "               [--reopen-after N] [--exit-status N] [--scene bars|planes]\n"
-          "               [--hud arrays|immediate|list|bitmap|copy]");
+          "               [--hud arrays|immediate|list|bitmap|copy] [--swap-interval N]");
       std::exit(0);
     } else {
       throw BadUsage("unknown option '" + a + "' (--help lists them)");
@@ -428,7 +435,7 @@ class GlfwGameWindow final : public GameWindow {
                                (o.mode == Mode::quad_buffer ? " with stereo buffers" : ""));
     }
     glfwMakeContextCurrent(window_);
-    glfwSwapInterval(0);  // the game paces itself at --fps
+    glfwSwapInterval(o.swap_interval);  // 0: the game paces itself at --fps
   }
   ~GlfwGameWindow() override {
     glfwDestroyWindow(window_);
@@ -467,7 +474,7 @@ class SdlGameWindow final : public GameWindow {
       SDL_Quit();
       throw std::runtime_error("SDL cannot make an OpenGL context: " + why);
     }
-    SDL_GL_SetSwapInterval(0);
+    SDL_GL_SetSwapInterval(o.swap_interval);
   }
   ~SdlGameWindow() override {
     SDL_GL_DeleteContext(context_);
@@ -545,7 +552,7 @@ int run(const Options& o) {
     deadline += period;
     const std::int64_t now = now_ns();
     if (now > deadline + period) deadline = now;  // fell behind: skip ahead rather than burst
-    sleep_until_ns(deadline);
+    if (o.swap_interval == 0) sleep_until_ns(deadline);
   }
   return g_stop ? 0 : o.exit_status;
 }

@@ -4,12 +4,16 @@
 // plays its window and ends with it, with its status; what cannot start is one line.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -155,6 +159,39 @@ TEST_F(LiveCliTest, RunGivesTheGamesDepthToTheCompositor) {
       "own); its depth is estimated from the views meanwhile";
   ASSERT_NE(flat.err.find(said), std::string::npos) << flat.err;
   EXPECT_EQ(flat.err.find(said, flat.err.find(said) + 1), std::string::npos) << flat.err;  // once
+}
+
+TEST_F(LiveCliTest, RunPacesAGameThatAsksForVsyncToTheDisplaysRefreshes) {
+  // A quad-buffer game that asks for a swap interval of N has its swaps return in time for every
+  // N-th of nelf's refreshes (the offscreen display's 60 Hz), as vsync does on a monitor; one that
+  // asks for 0 paces itself (here at 250 fps, not flat out: the other tests share the cores). The
+  // game's own log says when it presented each frame.
+  const auto median_interval_ms = [&](int interval) {
+    const auto log = dir_.path() / ("game" + std::to_string(interval) + ".csv");
+    const auto r = run_nelf("run --output offscreen --no-audio -- " + shell_quote(NELF_TEST_GAME) +
+                            " --mode quad-buffer --size 320x180 --fps 250 --duration 3 --swap-interval " +
+                            std::to_string(interval) + " --log " + shell_quote(log.string()));
+    EXPECT_EQ(r.status, 0) << r.err;
+    std::ifstream in(log);
+    std::string line;
+    std::getline(in, line);  // frame,present_ns
+    std::vector<std::int64_t> presents;
+    while (std::getline(in, line)) presents.push_back(std::stoll(line.substr(line.find(',') + 1)));
+    std::vector<double> intervals;
+    for (std::size_t i = 1; i < presents.size(); ++i)
+      if (presents[i] - presents.front() > 1'000'000'000)  // nelf playing by then
+        intervals.push_back((presents[i] - presents[i - 1]) / 1e6);
+    if (intervals.empty()) return 0.0;
+    std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2, intervals.end());
+    return intervals[intervals.size() / 2];
+  };
+  const double free = median_interval_ms(0), every = median_interval_ms(1), every_other = median_interval_ms(2);
+  std::printf("the game's median frame interval: swap interval 0 %.2f ms, 1 %.2f ms, 2 %.2f ms\n", free, every,
+              every_other);
+  EXPECT_GT(free, 0.0);
+  EXPECT_LT(free, 8.0);  // 4 ms asked
+  EXPECT_NEAR(every, 1000.0 / 60, 3.0);
+  EXPECT_NEAR(every_other, 2000.0 / 60, 4.0);
 }
 
 TEST_F(LiveCliTest, SimulateShowsWhatTheEyeSeesOfAGamesFrameWithItsDepth) {
