@@ -18,6 +18,7 @@
 // The slots are written in turn and
 // guarded by a sequence number (odd while written), so that a reader that fell behind notices a slot
 // overwritten under it instead of showing a torn frame; the game never waits for nelf.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 
@@ -70,6 +71,24 @@ inline std::size_t slot_stride(std::uint32_t width, std::uint32_t height) {
 }
 inline std::size_t shared_bytes(std::uint32_t width, std::uint32_t height) {
   return kSlots * slot_stride(width, height);
+}
+
+// nelf's refreshes as its refresh messages said them (period 0: none said).
+struct RefreshTiming {
+  std::int64_t refresh_ns = 0, period_ns = 0, lead_ns = 0;
+};
+
+// When a game's buffer swap made at `now` returns, with swap interval `interval`, for a game that
+// took `game_ns` to draw its last frame: so that its next frame is swapped `lead_ns` before the
+// first refresh it can reach, interval − 1 refreshes on. 0 (at once) for interval 0, or when no
+// refresh was said in the half second before `now` (convert, or a display that stopped).
+inline std::int64_t swap_returns_ns(const RefreshTiming& t, std::int64_t now, int interval, std::int64_t game_ns) {
+  if (interval <= 0 || t.period_ns <= 0 || now - t.refresh_ns > 500'000'000) return 0;
+  const std::int64_t early =
+      std::clamp<std::int64_t>(t.lead_ns, 0, t.period_ns) + std::clamp<std::int64_t>(game_ns, 0, t.period_ns);
+  const std::int64_t since = now + early - t.refresh_ns;  // the refresh reached: the first at or after now + early
+  const std::int64_t refreshes = since <= 0 ? 0 : (since + t.period_ns - 1) / t.period_ns;
+  return t.refresh_ns + (refreshes + interval - 1) * t.period_ns - early;
 }
 
 }  // namespace nelf::glx_stereo

@@ -24,9 +24,6 @@
 #include <GL/glx.h>
 #include <dlfcn.h>
 #include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/socket.h>
-#include <sys/un.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -46,11 +43,14 @@
 #include <utility>
 #include <vector>
 
+#include "inputs/glx_interposer/nelf_link.hpp"
 #include "inputs/glx_stereo_protocol.hpp"
 
 namespace {
 
 namespace protocol = nelf::glx_stereo;
+using nelf::glx_interposer::monotonic_ns;
+using nelf::glx_interposer::NelfLink;
 
 using DlsymFn = void* (*)(void*, const char*) noexcept;
 
@@ -95,165 +95,8 @@ Fn real_gl(const char* name) {
 #define NELF_REAL_GLX(name) static const auto real_##name = real_glx<decltype(&::name)>(#name)
 #define NELF_REAL_GL(name) static const auto real_##name = real_gl<decltype(&::name)>(#name)
 
-std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
-}
-
 bool is_right(GLenum buffer) { return buffer == GL_BACK_RIGHT || buffer == GL_FRONT_RIGHT || buffer == GL_RIGHT; }
 bool is_both(GLenum buffer) { return buffer == GL_BACK || buffer == GL_FRONT || buffer == GL_FRONT_AND_BACK; }
-
-// The link to nelf: a stream socket and the shared slots the eyes are written into.
-class NelfLink {
- public:
-  ~NelfLink() { close(); }
-
-  bool connected() const { return fd_ >= 0; }
-
-  // Connects and says hello; stereo links get shared memory for eyes of width × height. At most
-  // twice a second, so that a game without nelf listening loses nothing.
-  bool connect(bool stereo, std::uint32_t width, std::uint32_t height) {
-    const char* path = std::getenv(protocol::kSocketVariable);
-    if (!path || !*path || std::strlen(path) >= sizeof(sockaddr_un::sun_path)) return false;
-    const std::int64_t now = monotonic_ns();
-    if (now - last_try_ns_ < 500'000'000) return false;
-    last_try_ns_ = now;
-    const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-    if (fd < 0) return false;
-    sockaddr_un address{};
-    address.sun_family = AF_UNIX;
-    std::strcpy(address.sun_path, path);
-    if (::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
-      ::close(fd);
-      return false;
-    }
-    fd_ = fd;
-    protocol::Message hello;
-    hello.type = protocol::MessageType::hello;
-    hello.stereo = stereo ? 1 : 0;
-    hello.width = width;
-    hello.height = height;
-    int memory = -1;
-    if (stereo) {
-      bytes_ = protocol::shared_bytes(width, height);
-      memory = memfd_create("nelf-glx-stereo", MFD_CLOEXEC);
-      if (memory < 0 || ftruncate(memory, static_cast<off_t>(bytes_)) != 0) {
-        if (memory >= 0) ::close(memory);
-        close();
-        return false;
-      }
-      void* mapped = mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_SHARED, memory, 0);
-      if (mapped == MAP_FAILED) {
-        ::close(memory);
-        close();
-        return false;
-      }
-      shared_ = static_cast<unsigned char*>(mapped);
-      width_ = width;
-      height_ = height;
-    }
-    const bool sent = send(hello, memory);
-    if (memory >= 0) ::close(memory);  // nelf holds its own descriptor now
-    if (!sent) close();
-    return sent;
-  }
-
-  // The slot for `frame`, marked as being written; nullptr when not linked for stereo.
-  unsigned char* begin_slot(std::uint64_t frame) {
-    if (!shared_) return nullptr;
-    unsigned char* slot = shared_ + (frame % protocol::kSlots) * protocol::slot_stride(width_, height_);
-    auto* head = reinterpret_cast<protocol::SlotHeader*>(slot);
-    std::atomic_ref<std::uint64_t>(head->sequence).fetch_add(1, std::memory_order_acq_rel);  // odd: writing
-    return slot;
-  }
-
-  void end_slot(unsigned char* slot, std::uint64_t frame, std::int64_t swapped_ns) {
-    auto* head = reinterpret_cast<protocol::SlotHeader*>(slot);
-    head->frame = frame;
-    head->swapped_ns = swapped_ns;
-    std::atomic_ref<std::uint64_t>(head->sequence).fetch_add(1, std::memory_order_release);  // even: done
-    protocol::Message message;
-    message.type = protocol::MessageType::frame;
-    message.slot = static_cast<std::uint32_t>(frame % protocol::kSlots);
-    message.frame = frame;
-    message.swapped_ns = swapped_ns;
-    send(message, -1);
-  }
-
-  // What nelf said since the last call, read without waiting: whether it wants the depth buffers
-  // (it composites with the game's depth; once asked, always), and its newest refresh.
-  void read_messages() {
-    protocol::Message message;
-    while (fd_ >= 0 && ::recv(fd_, &message, sizeof message, MSG_DONTWAIT) == static_cast<ssize_t>(sizeof message)) {
-      if (message.magic != protocol::kMagic) continue;
-      if (message.type == protocol::MessageType::want_depth) depth_wanted_ = true;
-      if (message.type == protocol::MessageType::refresh && message.period_ns > 0) {
-        refresh_ns_ = message.refresh_ns;
-        period_ns_ = message.period_ns;
-        lead_ns_ = std::clamp<std::int64_t>(message.lead_ns, 0, message.period_ns);
-      }
-    }
-  }
-  bool depth_wanted() const { return depth_wanted_; }
-  bool linked_for_stereo() const { return fd_ >= 0 && shared_ != nullptr; }
-
-  // When a swap made at `now` with swap interval `interval` returns, for a game that takes
-  // `game_ns` to draw a frame: so that the next frame is swapped nelf's lead before the first of
-  // its refreshes it can reach, interval − 1 refreshes on; 0 (at once) for interval 0, or when nelf
-  // has said no refresh in the last half second (convert, or a display that stopped).
-  std::int64_t swap_returns_ns(std::int64_t now, int interval, std::int64_t game_ns) const {
-    if (interval <= 0 || period_ns_ <= 0 || now - refresh_ns_ > 500'000'000) return 0;
-    const std::int64_t early = lead_ns_ + std::clamp<std::int64_t>(game_ns, 0, period_ns_);
-    const std::int64_t since = now + early - refresh_ns_;  // the refresh reached: the first at or after now + early
-    const std::int64_t refreshes = since <= 0 ? 0 : (since + period_ns_ - 1) / period_ns_;
-    return refresh_ns_ + (refreshes + interval - 1) * period_ns_ - early;
-  }
-
-  void close() {
-    depth_wanted_ = false;
-    period_ns_ = 0;
-    if (shared_) munmap(shared_, bytes_);
-    shared_ = nullptr;
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = -1;
-  }
-
- private:
-  // Never blocks the game: a message nelf has no room for is dropped (nelf reads the newest frame
-  // anyway); a link nelf closed is closed here too.
-  bool send(const protocol::Message& message, int attached_fd) {
-    iovec io{const_cast<protocol::Message*>(&message), sizeof message};
-    msghdr header{};
-    header.msg_iov = &io;
-    header.msg_iovlen = 1;
-    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
-    if (attached_fd >= 0) {
-      header.msg_control = control;
-      header.msg_controllen = sizeof control;
-      cmsghdr* c = CMSG_FIRSTHDR(&header);
-      c->cmsg_level = SOL_SOCKET;
-      c->cmsg_type = SCM_RIGHTS;
-      c->cmsg_len = CMSG_LEN(sizeof(int));
-      std::memcpy(CMSG_DATA(c), &attached_fd, sizeof(int));
-    }
-    const int flags = MSG_NOSIGNAL | (attached_fd >= 0 ? 0 : MSG_DONTWAIT);
-    const ssize_t n = ::sendmsg(fd_, &header, flags);
-    if (n == static_cast<ssize_t>(sizeof message)) return true;
-    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return true;
-    close();
-    return false;
-  }
-
-  int fd_ = -1;
-  bool depth_wanted_ = false;
-  std::int64_t refresh_ns_ = 0, period_ns_ = 0;  // nelf's newest refresh, and its period (0: none said)
-  std::int64_t lead_ns_ = 0;
-  unsigned char* shared_ = nullptr;
-  std::size_t bytes_ = 0;
-  std::uint32_t width_ = 0, height_ = 0;
-  std::int64_t last_try_ns_ = -1'000'000'000'000LL;
-};
 
 // What one context keeps for the window it draws into.
 struct Eyes {
