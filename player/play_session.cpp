@@ -131,10 +131,11 @@ std::optional<PlayEnd> PlaySession::take_keys_and_events() {
 // Before the clock starts (after the first frame) or restarts (after a seek): the next frames
 // composited ahead, waiting up to 0.3 s. The worker's first frames take 40 ms and more (new
 // buffers, cold caches), and with the clock running the first refreshes dropped frames waiting
-// for them (2 of 300 at 30 fps in a run of tests/bench/play_pacing.sh).
+// for them (2 of 300 at 30 fps in a run of tests/bench/play_pacing.sh). Not for a live source:
+// its frames are shown newest first, not on the clock, and the game goes on drawing meanwhile.
 void PlaySession::start_clock() {
   compositor.composite_ahead(queue.front(queue_capacity), commands.overlays(), target);
-  compositor.wait_for_ahead(std::chrono::milliseconds(300));
+  if (!info.live) compositor.wait_for_ahead(std::chrono::milliseconds(300));
   clock.set_paused(false);
 }
 
