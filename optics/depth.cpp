@@ -78,7 +78,8 @@ Vec2 DisparitySurface::hit(Vec2 flat_uv, Vec2 gain) const {
   // A texel walk (Amanatides and Woo's): t = front − δ / W runs from 0 to the range; p is the ray's
   // texel coordinate at the front, v how many texels it moves per unit of t along each axis.
   const double range = front - back;
-  const double p[2] = {along(front).x * width_, along(front).y * height_};
+  const Vec2 at_front = along(front);
+  const double p[2] = {at_front.x * width_, at_front.y * height_};
   const double v[2] = {-gain.x * width_, -gain.y * height_};
   int texel[2], step[2];
   double delta[2], next[2];

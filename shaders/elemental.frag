@@ -40,7 +40,7 @@ out vec4 colour;
 // view is already averaged over; they find different crossings only at an edge of the content's
 // depth. Searching four times a border pixel cost as much as all of pass 1 on llvmpipe.
 layout(binding = 3) uniform sampler2D u_hits;  // R32F, panel-sized, written by elemental_depth_lookup.frag
-vec2 g_lattice_position;                       // of the fragment's centre
+vec2 g_lattice_position;                       // of the fragment's centre: area_sample's q (one sample)
 
 float hit_through(ivec2 lens) {
   const vec2 own = floor(g_lattice_position + 0.5);
@@ -117,6 +117,9 @@ vec3 area_sample(vec2 pixel, float aperture) {
   if (u_has_lens_array == 0) return point_sample(pixel);
   const vec2 s = display_position(pixel);
   const vec2 q = lattice_position(s);
+#ifdef NELF_DEPTH_HITS
+  g_lattice_position = q;
+#endif
   const vec2 half_pixel = 0.5 * aperture * u_pixel_pitch * u_to_lens_plane / u_lens_pitch;
   const vec2 own = floor(q + 0.5);
   const vec2 lo = q - half_pixel, hi = q + half_pixel;
@@ -195,9 +198,6 @@ void main() {
   // Stratified sub-samples (1, 2×2 or 4×4). Pass 1 point-samples each; the border-strip pass
   // (border_strips.vert) area-samples each sub-aperture, splitting it between the lenses it overlaps.
   const vec2 pixel_corner = floor(gl_FragCoord.xy - u_region_origin);
-#ifdef NELF_DEPTH_HITS
-  g_lattice_position = lattice_position(display_position(pixel_corner + 0.5));
-#endif
   const float step_ = 1.0 / float(u_subsamples);
   vec3 sum = vec3(0.0);
   for (int sy = 0; sy < u_subsamples; ++sy) {
