@@ -14,10 +14,10 @@
 // margin). A game that asks for a swap interval of N (glXSwapInterval*, 1 when it never asks, as
 // GLX has it) then has each buffer swap return so that its next frame, drawn in the time its last
 // one took, is swapped that long before a refresh, N refreshes on: it is shown at the first refresh
-// it can be, as vsync does on a monitor, and no later.
-// The slots are written in turn and
-// guarded by a sequence number (odd while written), so that a reader that fell behind notices a slot
-// overwritten under it instead of showing a torn frame; the game never waits for nelf.
+// it can be, as vsync does on a monitor, and no later; while nelf says no refresh, at 60 Hz
+// (vsync_returns_ns). The slots are written in turn and guarded by a sequence number (odd while
+// written), so that a reader that fell behind notices a slot overwritten under it instead of
+// showing a torn frame; the game never waits for nelf.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -89,6 +89,20 @@ inline std::int64_t swap_returns_ns(const RefreshTiming& t, std::int64_t now, in
   const std::int64_t since = now + early - t.refresh_ns;  // the refresh reached: the first at or after now + early
   const std::int64_t refreshes = since <= 0 ? 0 : (since + t.period_ns - 1) / t.period_ns;
   return t.refresh_ns + (refreshes + interval - 1) * t.period_ns - early;
+}
+
+// The period a vsync game is paced at while nelf says no refresh (play starting; convert has none):
+// a 60 Hz display's.
+inline constexpr std::int64_t kUntoldPeriodNs = 16'666'667;
+
+// When the interposer returns the swap: swap_returns_ns while nelf says its refreshes; otherwise
+// `interval` untold periods after the last swap returned (`last_return_ns`, 0: none yet, at once);
+// 0 (at once) for interval 0.
+inline std::int64_t vsync_returns_ns(const RefreshTiming& t, std::int64_t now, int interval, std::int64_t game_ns,
+                                     std::int64_t last_return_ns) {
+  if (interval <= 0) return 0;
+  if (const std::int64_t at = swap_returns_ns(t, now, interval, game_ns)) return at;
+  return last_return_ns != 0 ? std::max(now, last_return_ns + interval * kUntoldPeriodNs) : 0;
 }
 
 }  // namespace nelf::glx_stereo

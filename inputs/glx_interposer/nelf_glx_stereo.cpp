@@ -522,15 +522,9 @@ __attribute__((visibility("default"))) void glXSwapBuffers(Display* dpy, GLXDraw
     e->window_unpaced = true;
   }
   real_glXSwapBuffers(dpy, drawable);
-  // With a swap interval the swap returns in time for nelf's refresh (protocol: refresh), as vsync
-  // would; until nelf's display says its refreshes (play starting; convert has none), at 60 Hz.
-  std::int64_t returns = 0;
-  if (paced) {
-    const std::int64_t now = monotonic_ns();
-    returns = e->link.swap_returns_ns(now, interval, game_ns);
-    constexpr std::int64_t kUntilToldNs = 16'666'667;
-    if (returns == 0 && e->returned_ns != 0) returns = std::max(now, e->returned_ns + interval * kUntilToldNs);
-  }
+  // With a swap interval the swap returns in time for nelf's refresh, as vsync would
+  // (protocol: vsync_returns_ns).
+  const std::int64_t returns = paced ? e->link.swap_returns_ns(monotonic_ns(), interval, game_ns, e->returned_ns) : 0;
   ++e->swaps;
   // A resized window: the eyes follow, and nelf is told the new size on a new link.
   int width = 0, height = 0;

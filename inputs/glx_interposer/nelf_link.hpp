@@ -42,9 +42,10 @@ class NelfLink {
   bool depth_wanted() const { return depth_wanted_; }
   bool linked_for_stereo() const { return fd_ >= 0 && shared_ != nullptr; }
 
-  // When a swap made at `now` returns (protocol::swap_returns_ns); 0: at once.
-  std::int64_t swap_returns_ns(std::int64_t now, int interval, std::int64_t game_ns) const {
-    return protocol::swap_returns_ns({refresh_ns_, period_ns_, lead_ns_}, now, interval, game_ns);
+  // When a swap made at `now` returns (protocol::vsync_returns_ns); 0: at once.
+  std::int64_t swap_returns_ns(std::int64_t now, int interval, std::int64_t game_ns,
+                               std::int64_t last_return_ns) const {
+    return protocol::vsync_returns_ns({refresh_ns_, period_ns_, lead_ns_}, now, interval, game_ns, last_return_ns);
   }
 
   void close();

@@ -44,5 +44,17 @@ TEST(GlxStereoSwapReturns, AtOnceWithoutVsyncOrWithoutRecentRefreshes) {
   EXPECT_NE(swap_returns_ns(kDisplay, 1000 * ms + 499 * ms, 1, 2 * ms), 0);
 }
 
+TEST(GlxStereoSwapReturns, WhileNelfSaysNoRefreshAVsyncGameIsPacedAt60Hz) {
+  // What nelf says wins; without it (play starting, convert) `interval` periods of 60 Hz after the
+  // last return, or at once when that has passed or there was none.
+  EXPECT_EQ(vsync_returns_ns(kDisplay, 1003 * ms, 1, 2 * ms, 990 * ms),
+            swap_returns_ns(kDisplay, 1003 * ms, 1, 2 * ms));
+  EXPECT_EQ(vsync_returns_ns({}, 1003 * ms, 1, 2 * ms, 990 * ms), 990 * ms + kUntoldPeriodNs);
+  EXPECT_EQ(vsync_returns_ns({}, 1003 * ms, 2, 2 * ms, 990 * ms), 990 * ms + 2 * kUntoldPeriodNs);
+  EXPECT_EQ(vsync_returns_ns({}, 1030 * ms, 1, 2 * ms, 990 * ms), 1030 * ms);
+  EXPECT_EQ(vsync_returns_ns({}, 1003 * ms, 1, 2 * ms, 0), 0);
+  EXPECT_EQ(vsync_returns_ns({}, 1003 * ms, 0, 2 * ms, 990 * ms), 0);
+}
+
 }  // namespace
 }  // namespace nelf::glx_stereo
