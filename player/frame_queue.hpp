@@ -24,10 +24,16 @@ class FrameQueue {
  public:
   using Frame = CompositeAhead::Frame;
 
-  explicit FrameQueue(std::size_t capacity) : capacity_(capacity) {}
+  // When the queue is full: a file's decoder waits for room; a live source's frames are made in
+  // real time whether nelf reads them or not, so the newest are kept and the oldest dropped (a
+  // reader that waited would hand on frames as old as the stall that filled the queue).
+  enum class WhenFull { wait, drop_oldest };
 
-  // Decode thread: waits for room (or a seek, a new view format, or stop). Returns the seek target
-  // and the view format if one is pending.
+  explicit FrameQueue(std::size_t capacity, WhenFull when_full = WhenFull::wait)
+      : capacity_(capacity), when_full_(when_full) {}
+
+  // Decode thread: waits for room (or a seek, a new view format, or stop; never for room with
+  // drop_oldest). Returns the seek target and the view format if one is pending.
   struct Work {
     std::optional<double> seek_to;
     std::optional<ViewFormat> view_format;
@@ -36,13 +42,17 @@ class FrameQueue {
   };
   Work wait_for_work() {
     std::unique_lock lock(mutex_);
-    changed_.wait(lock, [&] { return stop_ || seek_to_ || view_format_ || (!end_ && items_.size() < capacity_); });
+    changed_.wait(lock, [&] {
+      return stop_ || seek_to_ || view_format_ ||
+             (!end_ && (when_full_ == WhenFull::drop_oldest || items_.size() < capacity_));
+    });
     Work work{std::exchange(seek_to_, std::nullopt), std::exchange(view_format_, std::nullopt), generation_, stop_};
     return work;
   }
   void push(StereoVideoFrame frame, std::uint64_t generation) {
     std::lock_guard lock(mutex_);
     if (generation != generation_) return;  // decoded before a seek
+    if (when_full_ == WhenFull::drop_oldest && items_.size() >= capacity_) items_.pop_front();
     items_.push_back(std::make_shared<const StereoVideoFrame>(std::move(frame)));
     changed_.notify_all();
   }
@@ -125,6 +135,7 @@ class FrameQueue {
   std::condition_variable changed_;
   std::deque<Frame> items_;
   std::size_t capacity_;
+  WhenFull when_full_;
   std::optional<double> seek_to_;
   std::optional<ViewFormat> view_format_;
   std::uint64_t generation_ = 0;

@@ -92,7 +92,7 @@ PlaySession::PlaySession(Display& display_, Source& source_, const PlayerOptions
       // game is late for its own cadence.
       scheduler(refresh_period, info.frame_rate > 0 && !info.live ? 1.0 / info.frame_rate : 0.0),
       view_format(source.negotiate(compositor.wanted_view_format(info.view))),
-      queue(queue_capacity),
+      queue(queue_capacity, info.live ? FrameQueue::WhenFull::drop_oldest : FrameQueue::WhenFull::wait),
       decoder([this] { decode_loop(source, queue, subtitle_drawing(options, subtitles)); }),
       commands(state, display, compositor, queue, sound, scheduler, options, info.duration_s, info.view, info.still,
                options.subtitles || !options.subtitle_tracks.empty() ? &subtitles : nullptr),
@@ -103,10 +103,19 @@ void PlaySession::wait_for_first_frame() {
   while (!queue.wait_for_frame(std::chrono::milliseconds(50))) {
     bool end = false;
     queue.snapshot(end);
-    if (end || (stop && stop->load()) || display.close_requested()) break;
+    if (end || (stop && stop->load()) || display.close_requested()) return;
     // Kept for the first refresh: a key typed while the file opens is not lost.
     for (const KeyPress& key : display.poll_events()) early_keys.push_back(key);
   }
+  // A live source's game goes on drawing while nelf makes its first composite (the composite tables
+  // loaded or recorded for the views' size, the shaders compiled at their first draw: 0.2 s on
+  // llvmpipe), and the frames it drew meanwhile were overtaken by the next one shown: most of the
+  // frames a game lost (docs/PERFORMANCE.md, live games). That first composite is made, unseen, of
+  // the first frame, and the first frame shown is then the newest. (A file's frames wait for the
+  // clock instead, which starts after the first is shown.)
+  if (info.live)
+    if (const std::vector<FrameQueue::Frame> first = queue.front(1); !first.empty())
+      compositor.render(first.front(), commands.overlays(), {target});
 }
 
 std::optional<PlayEnd> PlaySession::take_keys_and_events() {

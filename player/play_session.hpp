@@ -36,7 +36,8 @@ struct PlaySession {
   PlaySession& operator=(const PlaySession&) = delete;
 
   // Waits (briefly, polling the display) for the first frame, so that the clock does not run ahead
-  // of a slow start.
+  // of a slow start; for a live source, composites it once unseen so that the first composite's
+  // set-up does not hold up the frames after it.
   void wait_for_first_frame();
   // The keys since the last refresh carried out; why play ends now, if it does.
   std::optional<PlayEnd> take_keys_and_events();

@@ -110,5 +110,37 @@ TEST(FrameQueue, WaitUntilFullReturnsWithAFullQueueOrAtTheEnd) {
   stopped.wait_until_full();  // returns at once
 }
 
+// A live source's frames are made whether nelf reads them or not: when nelf is held up (its first
+// composite, a slow refresh) the queue keeps the newest, and the decoder goes on reading instead of
+// waiting for room and then handing on frames as old as the stall.
+TEST(FrameQueue, ALiveSourcesQueueKeepsTheNewestFramesWhenFull) {
+  FormatFollowingSource endless;
+  playback::FrameQueue queue(3, playback::FrameQueue::WhenFull::drop_oldest);
+  std::thread decoder([&] { playback::decode_loop(endless, queue); });
+  // Read on past the capacity: the oldest queued frame moves on.
+  bool end = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  std::vector<double> queued;
+  while ((queued = queue.snapshot(end)).empty() || queued.front() < 1.0) {
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "the decoder waited for room";
+    std::this_thread::yield();
+  }
+  queue.stop();
+  decoder.join();
+  queued = queue.snapshot(end);
+  ASSERT_EQ(queued.size(), 3u);
+  for (std::size_t i = 1; i < queued.size(); ++i) EXPECT_NEAR(queued[i] - queued[i - 1], 0.1, 1e-9);
+
+  // A file's decoder waits for room: the first frames stay.
+  FormatFollowingSource file;
+  playback::FrameQueue waiting(3);
+  std::thread file_decoder([&] { playback::decode_loop(file, waiting); });
+  waiting.wait_until_full();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_EQ(waiting.snapshot(end), (std::vector<double>{0.0, 0.1, 0.2}));
+  waiting.stop();
+  file_decoder.join();
+}
+
 }  // namespace
 }  // namespace nelf
