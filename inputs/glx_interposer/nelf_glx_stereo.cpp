@@ -13,48 +13,26 @@
 //
 // The game's view of the default framebuffer is kept: binding framebuffer 0 binds the current eye's
 // object, and the bindings, draw and read buffers it queries are what it set. Drawing with GL_BACK
-// (both eyes, as a game draws its HUD or clears) is done into each eye: every draw call, clear and
-// blit is made twice, once a framebuffer, and immediate mode (glBegin … glEnd) is recorded into a
-// display list and that called twice. What a display list, glBitmap or glBegin … glEnd change (the
-// current colour, the raster position, matrices) is put back between the two, so that the game's
-// state afterwards is that of one call.
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
-#include <GL/glx.h>
+// goes into both eyes (both_eyes.cpp); swap control is offered against nelf's refreshes
+// (swap_control.cpp).
 #include <dlfcn.h>
 #include <fcntl.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <map>
-#include <mutex>
-#include <optional>
 #include <span>
 #include <string>
-#include <string_view>
-#include <unordered_map>
-#include <utility>
 #include <vector>
 
+#include "inputs/glx_interposer/interposed_gl.hpp"
 #include "inputs/glx_interposer/nelf_link.hpp"
 #include "inputs/glx_stereo_protocol.hpp"
 
-namespace {
+namespace nelf::glx_interposer {
 
-namespace protocol = nelf::glx_stereo;
-using nelf::glx_interposer::monotonic_ns;
-using nelf::glx_interposer::NelfLink;
-
-using DlsymFn = void* (*)(void*, const char*) noexcept;
-
-// The real dlsym, found by version since dlsym itself is interposed (glibc 2.34 moved it).
 DlsymFn real_dlsym() {
   static const DlsymFn fn = [] {
     void* f = dlvsym(RTLD_NEXT, "dlsym", "GLIBC_2.34");
@@ -64,8 +42,6 @@ DlsymFn real_dlsym() {
   return fn;
 }
 
-// libGL as the game would get it; its own handle, so that a game that loads libGL privately
-// (RTLD_LOCAL, as GLFW and SDL2 do) is served from the same library.
 void* libgl() {
   static void* handle = dlopen("libGL.so.1", RTLD_LAZY | RTLD_LOCAL);
   return handle;
@@ -73,49 +49,10 @@ void* libgl() {
 
 void say(const char* line) { std::fprintf(stderr, "nelf-glx-stereo: %s\n", line); }
 
-template <typename Fn>
-Fn real_glx(const char* name) {
-  void* gl = libgl();
-  return gl ? reinterpret_cast<Fn>(real_dlsym()(gl, name)) : nullptr;
-}
-
-using GetProcFn = __GLXextFuncPtr (*)(const GLubyte*);
 GetProcFn real_get_proc() {
   static const GetProcFn fn = real_glx<GetProcFn>("glXGetProcAddressARB");
   return fn;
 }
-
-// A GL entry point of the current context's driver (core and extension functions alike).
-template <typename Fn>
-Fn real_gl(const char* name) {
-  const GetProcFn get = real_get_proc();
-  return get ? reinterpret_cast<Fn>(get(reinterpret_cast<const GLubyte*>(name))) : nullptr;
-}
-
-#define NELF_REAL_GLX(name) static const auto real_##name = real_glx<decltype(&::name)>(#name)
-#define NELF_REAL_GL(name) static const auto real_##name = real_gl<decltype(&::name)>(#name)
-
-bool is_right(GLenum buffer) { return buffer == GL_BACK_RIGHT || buffer == GL_FRONT_RIGHT || buffer == GL_RIGHT; }
-bool is_both(GLenum buffer) { return buffer == GL_BACK || buffer == GL_FRONT || buffer == GL_FRONT_AND_BACK; }
-
-// What one context keeps for the window it draws into.
-struct Eyes {
-  bool active = false;    // the game drew into a right buffer: each eye has its own framebuffer
-  bool unusable = false;  // the framebuffers could not be made: the game runs in mono
-  Display* display = nullptr;
-  GLXDrawable drawable = 0;
-  GLuint fbo[2] = {0, 0}, color[2] = {0, 0}, depth[2] = {0, 0};
-  int width = 0, height = 0;
-  GLenum draw_buffer = GL_BACK, read_buffer = GL_BACK;  // as the game set them on "framebuffer 0"
-  GLuint game_draw_fbo = 0, game_read_fbo = 0;          // the game's own framebuffer objects, 0: ours
-  bool compiling_list = false;  // between the game's glNewList and glEndList: drawing is recorded
-  GLuint immediate_list = 0;    // glBegin … glEnd into both eyes: recorded here, then called twice
-  bool recording_immediate = false;
-  std::uint64_t swaps = 0;
-  std::int64_t returned_ns = 0;  // when the last swap returned to the game (0: none yet)
-  bool window_unpaced = false;   // the driver's swap interval set to 0: nelf's refreshes pace the game
-  NelfLink link;
-};
 
 std::mutex g_mutex;
 std::unordered_map<GLXContext, Eyes>& contexts() {
@@ -123,59 +60,20 @@ std::unordered_map<GLXContext, Eyes>& contexts() {
   return map;
 }
 thread_local Eyes* t_current = nullptr;
+
+}  // namespace nelf::glx_interposer
+
+using namespace nelf::glx_interposer;
+
+namespace {
+
+namespace protocol = nelf::glx_stereo;
+
 // The mono verdict (glXSwapBuffers): said yet, and the swaps it waited for.
 bool g_said_mono = false;
 int g_mono_swaps = 0;
 std::int64_t g_first_swap_ns = 0;
 NelfLink g_verdict;
-
-// Swap control (GLX_EXT_swap_control, GLX_MESA_swap_control, GLX_SGI_swap_control) against nelf's
-// display, offered whether or not the driver has it (Mesa on Xvfb has none): the interval the game
-// asked for, 1 until it asks (GLX's default).
-std::atomic<int> g_swap_interval{1};
-constexpr const char* kSwapControl[] = {"GLX_EXT_swap_control", "GLX_MESA_swap_control", "GLX_SGI_swap_control"};
-
-bool lists(const char* extensions, std::string_view name) {
-  const std::string_view all = extensions ? extensions : "";
-  for (std::size_t at = all.find(name); at != std::string_view::npos; at = all.find(name, at + 1)) {
-    const std::size_t end = at + name.size();
-    if ((at == 0 || all[at - 1] == ' ') && (end == all.size() || all[end] == ' ')) return true;
-  }
-  return false;
-}
-
-// The driver's own swap interval for the game's window, where the driver has swap control.
-void driver_swap_interval(Display* dpy, GLXDrawable drawable, int interval) {
-  NELF_REAL_GLX(glXQueryExtensionsString);
-  NELF_REAL_GLX(glXGetCurrentDisplay);
-  if (!dpy) dpy = real_glXGetCurrentDisplay();
-  if (!dpy || !real_glXQueryExtensionsString) return;
-  const char* extensions = real_glXQueryExtensionsString(dpy, DefaultScreen(dpy));
-  using Ext = void (*)(Display*, GLXDrawable, int);
-  using Mesa = int (*)(unsigned int);
-  using Sgi = int (*)(int);
-  if (lists(extensions, kSwapControl[0]) && drawable) {
-    if (const auto f = real_gl<Ext>("glXSwapIntervalEXT")) f(dpy, drawable, interval);
-  } else if (lists(extensions, kSwapControl[1])) {
-    if (const auto f = real_gl<Mesa>("glXSwapIntervalMESA")) f(static_cast<unsigned int>(interval));
-  } else if (lists(extensions, kSwapControl[2]) && interval > 0) {
-    if (const auto f = real_gl<Sgi>("glXSwapIntervalSGI")) f(interval);
-  }
-}
-
-// The game's interval, kept for glXSwapBuffers and given to the driver, except for a window whose
-// swaps nelf's refreshes pace (the driver's vsync to the desktop's monitor would add its own wait).
-void set_swap_interval(Display* dpy, GLXDrawable drawable, int interval) {
-  g_swap_interval = interval;
-  const Eyes* e = t_current;
-  driver_swap_interval(dpy, drawable, e && e->window_unpaced ? 0 : interval);
-}
-
-void sleep_until_ns(std::int64_t t) {
-  timespec ts{static_cast<time_t>(t / 1000000000LL), static_cast<long>(t % 1000000000LL)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
-}
 
 // This thread's context is now `context`, drawing into `drawable` (both make-current calls).
 void made_current(Display* display, GLXDrawable drawable, GLXContext context) {
@@ -345,72 +243,6 @@ void show_left_eye(const Eyes& e) {
   if (scissor) real_glEnable(GL_SCISSOR_TEST);
 }
 
-// Whether drawing now goes into both eyes: GL_BACK (or another name of both) on "framebuffer 0" of
-// a context whose eyes have their own framebuffers, and not into a display list being compiled
-// (that drawing is recorded, and made into both eyes when the list is called), nor between glBegin
-// and glEnd (a list called there is recorded with the vertices).
-Eyes* drawing_both_eyes() {
-  Eyes* e = t_current;
-  return e && e->active && e->game_draw_fbo == 0 && !e->compiling_list && !e->recording_immediate &&
-                 is_both(e->draw_buffer)
-             ? e
-             : nullptr;
-}
-
-// The state a display list, glBitmap or immediate mode may change, kept over the first eye's
-// drawing and put back before the second: the attribute groups (current colour, raster position,
-// enables, …) and the three matrices. Compatibility contexts only, where those calls exist.
-class KeptState {
- public:
-  KeptState() {
-    NELF_REAL_GL(glGetIntegerv);
-    NELF_REAL_GL(glGetFloatv);
-    NELF_REAL_GL(glPushAttrib);
-    GLint depth = 0, most = 0;
-    real_glGetIntegerv(GL_ATTRIB_STACK_DEPTH, &depth);
-    real_glGetIntegerv(GL_MAX_ATTRIB_STACK_DEPTH, &most);
-    pushed_ = depth < most;
-    if (pushed_) real_glPushAttrib(GL_ALL_ATTRIB_BITS);
-    real_glGetIntegerv(GL_MATRIX_MODE, &mode_);
-    real_glGetFloatv(GL_MODELVIEW_MATRIX, matrices_[0]);
-    real_glGetFloatv(GL_PROJECTION_MATRIX, matrices_[1]);
-    real_glGetFloatv(GL_TEXTURE_MATRIX, matrices_[2]);
-  }
-  void put_back() const {
-    NELF_REAL_GL(glPopAttrib);
-    NELF_REAL_GL(glMatrixMode);
-    NELF_REAL_GL(glLoadMatrixf);
-    if (pushed_) real_glPopAttrib();
-    const GLenum modes[3] = {GL_MODELVIEW, GL_PROJECTION, GL_TEXTURE};
-    for (int i = 0; i < 3; ++i) {
-      real_glMatrixMode(modes[i]);
-      real_glLoadMatrixf(matrices_[i]);
-    }
-    real_glMatrixMode(static_cast<GLenum>(mode_));
-  }
-
- private:
-  bool pushed_ = false;
-  GLint mode_ = GL_MODELVIEW;
-  GLfloat matrices_[3][16] = {};
-};
-
-// Makes `draw` into the right eye, then into the left, when drawing goes into both; once otherwise.
-// `keep_state`: for calls that change state (display lists, glBitmap, immediate mode).
-template <typename Draw>
-void into_eyes(Draw draw, bool keep_state = false) {
-  NELF_REAL_GL(glBindFramebuffer);
-  const Eyes* e = drawing_both_eyes();
-  if (!e) return draw();
-  std::optional<KeptState> kept;
-  if (keep_state) kept.emplace();
-  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e->fbo[1]);
-  draw();
-  real_glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e->fbo[0]);
-  if (kept) kept->put_back();
-  draw();
-}
-
 // glXChooseVisual's list: GLX_STEREO (a flag without a value) removed.
 std::vector<int> without_stereo_flag(const int* attributes) {
   std::vector<int> out;
@@ -514,7 +346,7 @@ __attribute__((visibility("default"))) void glXSwapBuffers(Display* dpy, GLXDraw
   const std::int64_t swapped_ns = monotonic_ns();
   send_eyes(*e, swapped_ns);
   show_left_eye(*e);
-  const int interval = g_swap_interval.load();
+  const int interval = swap_interval();
   const std::int64_t game_ns = e->returned_ns != 0 ? swapped_ns - e->returned_ns : 0;  // its last frame's drawing
   const bool paced = interval > 0 && e->link.linked_for_stereo();
   if (paced && !e->window_unpaced) {
@@ -536,49 +368,6 @@ __attribute__((visibility("default"))) void glXSwapBuffers(Display* dpy, GLXDraw
   bind_read(*e);
   if (returns != 0) sleep_until_ns(returns);
   e->returned_ns = monotonic_ns();
-}
-
-__attribute__((visibility("default"))) void glXSwapIntervalEXT(Display* dpy, GLXDrawable drawable, int interval) {
-  set_swap_interval(dpy, drawable, interval < 0 ? -interval : interval);  // < 0: adaptive, as vsync here
-}
-
-__attribute__((visibility("default"))) int glXSwapIntervalMESA(unsigned int interval) {
-  set_swap_interval(nullptr, 0, static_cast<int>(interval));
-  return 0;
-}
-
-__attribute__((visibility("default"))) int glXSwapIntervalSGI(int interval) {
-  if (interval <= 0) return GLX_BAD_VALUE;
-  set_swap_interval(nullptr, 0, interval);
-  return 0;
-}
-
-__attribute__((visibility("default"))) int glXGetSwapIntervalMESA() { return g_swap_interval.load(); }
-
-__attribute__((visibility("default"))) void glXQueryDrawable(Display* dpy, GLXDrawable drawable, int attribute,
-                                                             unsigned int* value) {
-  NELF_REAL_GLX(glXQueryDrawable);
-  if (attribute == GLX_SWAP_INTERVAL_EXT)
-    *value = static_cast<unsigned int>(g_swap_interval.load());
-  else if (attribute == GLX_MAX_SWAP_INTERVAL_EXT)
-    *value = 8;
-  else if (real_glXQueryDrawable)
-    real_glXQueryDrawable(dpy, drawable, attribute, value);
-}
-
-// The driver's extensions and swap control (above).
-__attribute__((visibility("default"))) const char* glXQueryExtensionsString(Display* dpy, int screen) {
-  NELF_REAL_GLX(glXQueryExtensionsString);
-  const char* real = real_glXQueryExtensionsString ? real_glXQueryExtensionsString(dpy, screen) : nullptr;
-  std::lock_guard lock(g_mutex);
-  static std::map<std::pair<Display*, int>, std::string> answers;  // nodes stay put: the pointers hold
-  std::string& answer = answers[{dpy, screen}];
-  if (answer.empty()) {
-    answer = real ? real : "";
-    for (const char* name : kSwapControl)
-      if (!lists(real, name)) answer += answer.empty() ? std::string(name) : " " + std::string(name);
-  }
-  return answer.c_str();
 }
 
 __attribute__((visibility("default"))) void glDrawBuffer(GLenum buffer) {
@@ -641,111 +430,6 @@ __attribute__((visibility("default"))) void glGetBooleanv(GLenum name, GLboolean
   NELF_REAL_GL(glGetBooleanv);
   real_glGetBooleanv(name, data);
   if (name == GL_STEREO && t_current) *data = GL_TRUE;
-}
-
-// Drawing into both back buffers (GL_BACK on a stereo framebuffer) draws into both eyes: each of
-// these calls, as (name, parameters, arguments), is defined below to be made into each eye's
-// framebuffer (into_eyes), and answered for by name in interposed().
-#define NELF_INTO_EYES_CALLS(X)                                                                                     \
-  X(glClear, (GLbitfield mask), (mask))                                                                             \
-  X(glClearBufferfv, (GLenum buffer, GLint drawbuffer, const GLfloat* value), (buffer, drawbuffer, value))          \
-  X(glClearBufferiv, (GLenum buffer, GLint drawbuffer, const GLint* value), (buffer, drawbuffer, value))            \
-  X(glClearBufferuiv, (GLenum buffer, GLint drawbuffer, const GLuint* value), (buffer, drawbuffer, value))          \
-  X(glClearBufferfi, (GLenum buffer, GLint drawbuffer, GLfloat depth, GLint stencil),                               \
-    (buffer, drawbuffer, depth, stencil))                                                                           \
-  X(glDrawArrays, (GLenum mode, GLint first, GLsizei count), (mode, first, count))                                  \
-  X(glDrawElements, (GLenum mode, GLsizei count, GLenum type, const void* indices), (mode, count, type, indices))   \
-  X(glDrawRangeElements, (GLenum mode, GLuint start, GLuint end, GLsizei count, GLenum type, const void* indices),  \
-    (mode, start, end, count, type, indices))                                                                       \
-  X(glDrawArraysInstanced, (GLenum mode, GLint first, GLsizei count, GLsizei instances),                            \
-    (mode, first, count, instances))                                                                                \
-  X(glDrawElementsInstanced, (GLenum mode, GLsizei count, GLenum type, const void* indices, GLsizei instances),     \
-    (mode, count, type, indices, instances))                                                                        \
-  X(glDrawElementsBaseVertex, (GLenum mode, GLsizei count, GLenum type, const void* indices, GLint base),           \
-    (mode, count, type, indices, base))                                                                             \
-  X(glDrawRangeElementsBaseVertex,                                                                                  \
-    (GLenum mode, GLuint start, GLuint end, GLsizei count, GLenum type, const void* indices, GLint base),           \
-    (mode, start, end, count, type, indices, base))                                                                 \
-  X(glDrawElementsInstancedBaseVertex,                                                                              \
-    (GLenum mode, GLsizei count, GLenum type, const void* indices, GLsizei instances, GLint base),                  \
-    (mode, count, type, indices, instances, base))                                                                  \
-  X(glMultiDrawArrays, (GLenum mode, const GLint* first, const GLsizei* count, GLsizei n), (mode, first, count, n)) \
-  X(glMultiDrawElements, (GLenum mode, const GLsizei* count, GLenum type, const void* const* indices, GLsizei n),   \
-    (mode, count, type, indices, n))                                                                                \
-  X(glDrawArraysIndirect, (GLenum mode, const void* indirect), (mode, indirect))                                    \
-  X(glDrawElementsIndirect, (GLenum mode, GLenum type, const void* indirect), (mode, type, indirect))               \
-  X(glBlitFramebuffer,                                                                                              \
-    (GLint sx0, GLint sy0, GLint sx1, GLint sy1, GLint dx0, GLint dy0, GLint dx1, GLint dy1, GLbitfield mask,       \
-     GLenum filter),                                                                                                \
-    (sx0, sy0, sx1, sy1, dx0, dy0, dx1, dy1, mask, filter))                                                         \
-  X(glDrawPixels, (GLsizei width, GLsizei height, GLenum format, GLenum type, const void* pixels),                  \
-    (width, height, format, type, pixels))                                                                          \
-  X(glCopyPixels, (GLint x, GLint y, GLsizei width, GLsizei height, GLenum type), (x, y, width, height, type))      \
-  X(glRectf, (GLfloat x1, GLfloat y1, GLfloat x2, GLfloat y2), (x1, y1, x2, y2))                                    \
-  X(glRectd, (GLdouble x1, GLdouble y1, GLdouble x2, GLdouble y2), (x1, y1, x2, y2))                                \
-  X(glRecti, (GLint x1, GLint y1, GLint x2, GLint y2), (x1, y1, x2, y2))                                            \
-  X(glRects, (GLshort x1, GLshort y1, GLshort x2, GLshort y2), (x1, y1, x2, y2))
-#define NELF_INTO_EYES(name, parameters, arguments)             \
-  __attribute__((visibility("default"))) void name parameters { \
-    NELF_REAL_GL(name);                                         \
-    into_eyes([&] { real_##name arguments; });                  \
-  }
-NELF_INTO_EYES_CALLS(NELF_INTO_EYES)
-#undef NELF_INTO_EYES
-
-// These change state (a list may set the colour or a matrix; glBitmap moves the raster position):
-// it is put back between the eyes.
-__attribute__((visibility("default"))) void glCallList(GLuint list) {
-  NELF_REAL_GL(glCallList);
-  into_eyes([&] { real_glCallList(list); }, true);
-}
-__attribute__((visibility("default"))) void glCallLists(GLsizei n, GLenum type, const void* lists) {
-  NELF_REAL_GL(glCallLists);
-  into_eyes([&] { real_glCallLists(n, type, lists); }, true);
-}
-__attribute__((visibility("default"))) void glBitmap(GLsizei width, GLsizei height, GLfloat x, GLfloat y,
-                                                     GLfloat move_x, GLfloat move_y, const GLubyte* bitmap) {
-  NELF_REAL_GL(glBitmap);
-  into_eyes([&] { real_glBitmap(width, height, x, y, move_x, move_y, bitmap); }, true);
-}
-
-// Drawing recorded into the game's own display list is made into both eyes when the list is called.
-__attribute__((visibility("default"))) void glNewList(GLuint list, GLenum mode) {
-  NELF_REAL_GL(glNewList);
-  if (Eyes* e = t_current) e->compiling_list = true;
-  real_glNewList(list, mode);
-}
-__attribute__((visibility("default"))) void glEndList() {
-  NELF_REAL_GL(glEndList);
-  if (Eyes* e = t_current) e->compiling_list = false;
-  real_glEndList();
-}
-
-// Immediate mode into both eyes: the vertices between glBegin and glEnd are recorded into a list of
-// the interposer's, which is then called into each eye.
-__attribute__((visibility("default"))) void glBegin(GLenum mode) {
-  NELF_REAL_GL(glBegin);
-  NELF_REAL_GL(glGenLists);
-  NELF_REAL_GL(glNewList);
-  if (Eyes* e = drawing_both_eyes()) {
-    if (!e->immediate_list) e->immediate_list = real_glGenLists(1);
-    if (e->immediate_list) {
-      real_glNewList(e->immediate_list, GL_COMPILE);
-      e->recording_immediate = true;
-    }
-  }
-  real_glBegin(mode);
-}
-__attribute__((visibility("default"))) void glEnd() {
-  NELF_REAL_GL(glEnd);
-  NELF_REAL_GL(glEndList);
-  NELF_REAL_GL(glCallList);
-  real_glEnd();
-  Eyes* e = t_current;
-  if (!e || !e->recording_immediate) return;
-  e->recording_immediate = false;
-  real_glEndList();
-  into_eyes([&] { real_glCallList(e->immediate_list); }, true);
 }
 
 __GLXextFuncPtr glXGetProcAddressARB(const GLubyte* name);
