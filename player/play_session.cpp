@@ -113,9 +113,24 @@ void PlaySession::wait_for_first_frame() {
   // frames a game lost (docs/PERFORMANCE.md, live games). That first composite is made, unseen, of
   // the first frame, and the first frame shown is then the newest. (A file's frames wait for the
   // clock instead, which starts after the first is shown.)
-  if (info.live)
-    if (const std::vector<FrameQueue::Frame> first = queue.front(1); !first.empty())
-      compositor.render(first.front(), commands.overlays(), {target});
+  if (!info.live) return;
+  // And the refreshes to come are said from now on, around that composite rather than after the
+  // first refresh: a game timing its swaps to them (a quad-buffer game with vsync) is in step from
+  // its next frame, not two or three frames late.
+  announce_next_refresh();
+  if (const std::vector<FrameQueue::Frame> first = queue.front(1); !first.empty())
+    compositor.render(first.front(), commands.overlays(), {target});
+  announce_next_refresh();
+}
+
+// Without vsync the ticker's next tick is known ahead (with vsync, present() says when a refresh
+// begins: wait_for_next_refresh).
+void PlaySession::announce_next_refresh() {
+  if (options.clock || display.vsync()) return;
+  using namespace std::chrono;
+  const auto refresh = ticker.next_after(steady_clock::now());
+  source.refresh_at(duration_cast<nanoseconds>(refresh.time_since_epoch()).count(),
+                    duration_cast<nanoseconds>(duration<double>(refresh_period)).count());
 }
 
 std::optional<PlayEnd> PlaySession::take_keys_and_events() {

@@ -39,6 +39,8 @@ struct PlaySession {
   // of a slow start; for a live source, composites it once unseen so that the first composite's
   // set-up does not hold up the frames after it.
   void wait_for_first_frame();
+  // Tells a live source when the next refresh begins, before the loop reaches it (no vsync).
+  void announce_next_refresh();
   // The keys since the last refresh carried out; why play ends now, if it does.
   std::optional<PlayEnd> take_keys_and_events();
   // Starts the clock (after the first frame, or a seek) once the next frames are composited ahead.

@@ -28,20 +28,29 @@ class RenderTime {
   double median_s_;
 };
 
-// Without vsync nothing paces the loop but this: a tick every refresh period, slept to.
+// Without vsync nothing paces the loop but this: a tick every refresh period, slept to. The ticks
+// keep their phase, as a display's refreshes do, so that a live source can be told them before the
+// loop reaches them (a quad-buffer game times its swaps to them).
 class RefreshTicker {
  public:
   using Steady = std::chrono::steady_clock;
   explicit RefreshTicker(double period_s)
-      : period_(std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(period_s))) {}
+      : period_(std::max(Steady::duration(1),
+                         std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(period_s)))) {}
   void sleep_to_next() {
     next_ += period_;
     const auto now = Steady::now();
-    if (next_ < now - std::chrono::milliseconds(100)) next_ = now;  // far behind: do not race
+    // Far behind (a stall): on to the latest tick that has passed, whole periods on, rather than
+    // racing through the ones missed.
+    if (next_ < now - std::chrono::milliseconds(100)) next_ += (now - next_) / period_ * period_;
     std::this_thread::sleep_until(next_);
   }
   // The refresh sleep_to_next() slept to (it returns late when the loop overran it).
   Steady::time_point tick() const { return next_; }
+  // The first tick at or after `t`.
+  Steady::time_point next_after(Steady::time_point t) const {
+    return t <= next_ ? next_ : next_ + (t - next_ + period_ - Steady::duration(1)) / period_ * period_;
+  }
 
  private:
   Steady::duration period_;
