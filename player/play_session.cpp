@@ -127,8 +127,11 @@ void PlaySession::wait_for_first_frame() {
 // begins: wait_for_next_refresh).
 void PlaySession::announce_next_refresh() {
   if (options.clock || display.vsync()) return;
+  tell_source_refresh(ticker.next_after(std::chrono::steady_clock::now()));
+}
+
+void PlaySession::tell_source_refresh(std::chrono::steady_clock::time_point refresh) {
   using namespace std::chrono;
-  const auto refresh = ticker.next_after(steady_clock::now());
   source.refresh_at(duration_cast<nanoseconds>(refresh.time_since_epoch()).count(),
                     duration_cast<nanoseconds>(duration<double>(refresh_period)).count());
 }
@@ -177,10 +180,7 @@ void PlaySession::wait_for_next_refresh() {
   if (!display.vsync()) ticker.sleep_to_next();
   // A refresh begins (with vsync, present() returned at it): a live source may time its frames to
   // it (a quad-buffer game's swaps).
-  using namespace std::chrono;
-  const auto refresh = display.vsync() ? steady_clock::now() : ticker.tick();
-  source.refresh_at(duration_cast<nanoseconds>(refresh.time_since_epoch()).count(),
-                    duration_cast<nanoseconds>(duration<double>(refresh_period)).count());
+  tell_source_refresh(display.vsync() ? std::chrono::steady_clock::now() : ticker.tick());
 }
 
 PlayResult PlaySession::finish(std::int64_t composited_ahead) {

@@ -41,6 +41,8 @@ struct PlaySession {
   void wait_for_first_frame();
   // Tells a live source when the next refresh begins, before the loop reaches it (no vsync).
   void announce_next_refresh();
+  // Source::refresh_at of the refresh beginning at `refresh`, a period long.
+  void tell_source_refresh(std::chrono::steady_clock::time_point refresh);
   // The keys since the last refresh carried out; why play ends now, if it does.
   std::optional<PlayEnd> take_keys_and_events();
   // Starts the clock (after the first frame, or a seek) once the next frames are composited ahead.
