@@ -14,9 +14,10 @@ namespace nelf {
 // rounded to the nearest code value.
 std::vector<std::uint8_t> view_bytes(const Image& image, int bits);
 
-// A view of 8-bit RGBA rows as (width / bx) × (height / by) means of bx × by pixels (1 × 1: a
-// copy), alpha 255: the ViewFormat block the compositor negotiated, made while the pixels are in
-// cache (the live captures: a window's rows, a game's eyes). `first_row` is the view's top row;
+// A view of 8-bit RGBA rows as (width / bx) × (height / by) means of bx × by pixels, each rounded
+// to the nearest code value, alpha 255 (1 × 1: the rows copied as they are): the ViewFormat block
+// the compositor negotiated, made while the pixels are in cache (the live captures: a window's
+// rows, a game's eyes). `first_row` is the view's top row;
 // rows are `row_stride` bytes apart, negative for images stored bottom-up (OpenGL's read-back).
 std::vector<std::uint8_t> rgba8_block_means(const std::uint8_t* first_row, std::ptrdiff_t row_stride, int width,
                                             int height, std::array<int, 2> block);
