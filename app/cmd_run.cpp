@@ -1,8 +1,9 @@
-// `nelf run [play options] -- GAME [ARGS...]`: starts a stereo game and shows it on the HMD. A
-// quad-buffer OpenGL game gets nelf's interposer (LD_PRELOAD) and its two eyes come from there (the
-// glx-stereo: source); a game that draws both eyes into one picture has the window its process
-// opens (its _NET_WM_PID, or the title --window names) captured live (the x11: source), its layout
-// detected as for a file or given by --layout. Either is played with play's options. nelf ends
+// `nelf run [play options] -- GAME [ARGS...]`: starts a stereo game and shows it on the HMD. An
+// OpenGL game gets nelf's interposer (LD_PRELOAD), and what it swaps comes from there (the
+// glx-stereo: source): a quad-buffer game's two eyes, or the picture of a game that draws both
+// eyes into one, its layout detected as for a file or given by --layout. A game that swaps no
+// OpenGL buffer through GLX (or a window --window names) has its window captured live instead
+// (the x11: source; its _NET_WM_PID's window). Either is played with play's options. nelf ends
 // when the game does, with the game's exit status; quitting nelf (q, closing its window, Ctrl-C)
 // ends the game too.
 #include <fmt/format.h>
@@ -58,14 +59,15 @@ void run_game(const RunArgs& args, const std::vector<std::string>& command) {
   if (args.wait_s <= 0) throw UserError("--wait must be more than 0 seconds", 2);
   // From the start: a Ctrl-C while the game starts or between its windows ends both too.
   InterruptGuard guard;
-  // Quad-buffer games: nelf's interposer goes into the game and hands over both eyes at each swap
-  // (inputs/glx_stereo_source.hpp); a game that draws one picture is played from its window.
+  // nelf's interposer goes into the game and hands over both eyes, or the one picture, at each
+  // swap (inputs/glx_stereo_source.hpp): no trip through the X server, and vsync to nelf's
+  // refreshes for either.
   const std::string socket = interposer_socket_path();
   std::string preload = glx_stereo_library_path();
   if (const char* before = std::getenv("LD_PRELOAD"); before && *before) preload += std::string(":") + before;
   GameProcess game(command, {"LD_PRELOAD=" + preload, std::string(glx_stereo::kSocketVariable) + "=" + socket});
-  // --window names a window to capture: the user says the game draws into one.
-  bool eyes_from_interposer = args.window.empty();
+  // --window names a window to capture: its picture, whoever draws it, through the X server.
+  bool from_interposer = args.window.empty();
   // Stops waiting for the first swap when the user interrupts or the game ends without one.
   std::atomic<bool> stop_waiting{false};
   std::jthread watcher([&](std::stop_token stop) {
@@ -74,32 +76,28 @@ void run_game(const RunArgs& args, const std::vector<std::string>& command) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
   });
-  RunArgs eyes_args = args;
-  eyes_args.layout = "auto";  // the eyes come on their own; --layout is for a window
   // Games close their window and open another (a splash or launcher first, a new window for a new
   // video mode): while the game runs, nelf plays each window it opens.
   for (bool first = true;; first = false) {
     PlayEnd end = PlayEnd::end_of_file;
     try {
-      if (eyes_from_interposer) {
+      if (from_interposer) {
         SourceRequest request;
         request.stop = &stop_waiting;
         request.input = fmt::format("glx-stereo:wait={:g},socket={}", kFirstSwapWait_s, socket);
         try {
-          end = play_input(eyes_args, request);
-        } catch (const GameDrawsOnePicture&) {
-          eyes_from_interposer = false;
+          end = play_input(args, request);  // --layout: for a game that draws one picture
         } catch (const GameDidNotSwap&) {
-          eyes_from_interposer = false;
+          from_interposer = false;
           if (!args.quiet)
             fmt::print(stderr, "nelf: {} swapped no OpenGL frame in {:g} s: waiting for its window\n",
                        printable(game.name()), kFirstSwapWait_s);
         } catch (const UserError& e) {
           if (e.status() != 130 || interrupt_requested) throw;
-          eyes_from_interposer = false;  // the game ended while nelf waited: its status follows
+          from_interposer = false;  // the game ended while nelf waited: its status follows
         }
       }
-      if (!eyes_from_interposer) {
+      if (!from_interposer) {
         SourceRequest request;
         request.stop = &interrupt_requested;
         // window= takes the rest of the spec (a title may hold commas), so it comes last.
@@ -137,7 +135,8 @@ void add_run_command(CLI::App& app) {
       "run", "Start a stereo game and play its window on the display: nelf run [options] -- GAME [ARGS...]");
   add_play_options(*cmd, *args);
   cmd->add_option("--window", args->window,
-                  "The game's window: a part of its title (default: the window the game's process opens)");
+                  "Capture this window (a part of its title) through the X server instead of reading what the "
+                  "game swaps (default: what an OpenGL game swaps, else the window its process opens)");
   cmd->add_option("--wait", args->wait_s, "How long to wait for the game's window, in seconds")->capture_default_str();
   // After `--`, everything is the game's command line, its options included.
   cmd->add_option("game", args->game, "The game and its arguments, after --")->expected(-1);

@@ -1,4 +1,5 @@
-// The glx-stereo driver: a quad-buffer game's eyes as a live stereo source (glx_stereo_source.hpp).
+// The glx-stereo driver: a quad-buffer game's eyes, or the picture of a game that draws one, as a live
+// stereo source (glx_stereo_source.hpp).
 // Each frame is the newest the game swapped: older ones still in the socket are skipped, as a live
 // window's are, and a slot the game overwrote while it was copied is dropped and counted.
 #include <fmt/format.h>
@@ -24,7 +25,9 @@
 #include "inputs/glx_stereo_protocol.hpp"
 #include "inputs/glx_stereo_source.hpp"
 #include "inputs/source.hpp"
+#include "inputs/stereo_layout.hpp"
 #include "inputs/view_bytes.hpp"
+#include "inputs/view_regions.hpp"
 
 namespace nelf {
 
@@ -123,9 +126,7 @@ class GlxStereoSource final : public Source {
       throw UserError(fmt::format("{}: the game's interposer said something else than hello (another nelf version?)",
                                   printable(input_)),
                       1);
-    if (!hello->message.stereo)
-      throw GameDrawsOnePicture(
-          fmt::format("{}: the game draws one picture (never into GL_BACK_RIGHT)", printable(input_)), 1);
+    picture_ = !hello->message.stereo;
     width_ = static_cast<int>(hello->message.width);
     height_ = static_cast<int>(hello->message.height);
     const std::size_t bytes = protocol::shared_bytes(hello->message.width, hello->message.height);
@@ -134,14 +135,40 @@ class GlxStereoSource final : public Source {
                        : MAP_FAILED;
     if (mapped == MAP_FAILED) throw UserError(fmt::format("{}: cannot map the game's frames", printable(input_)), 1);
     shared_ = std::unique_ptr<unsigned char, Unmap>(static_cast<unsigned char*>(mapped), Unmap{bytes});
-    if (r.known_depth) {
+    if (picture_) {
+      // Its two views are where its layout puts them, as in a captured window.
+      LayoutEvidence evidence{r.layout, std::nullopt, width_, height_, {}};
+      evidence.swap_eyes = r.swap_eyes;
+      const LayoutDecision decision = detect_stereo_layout(evidence);
+      try {
+        regions_ = view_regions(decision.layout, width_, height_, decision.swap_eyes);
+      } catch (const LayoutError& e) {
+        throw UserError(fmt::format("{}: {}", printable(input_), e.what()), 2);
+      }
+      if (!decision.warning.empty() && !r.quiet)
+        fmt::print(stderr, "nelf: warning: {}: {}\n", printable(input_), printable(decision.warning));
+      description_ = fmt::format(
+          "{}: the window of an OpenGL game (process {}), {}x{} read at each swap, two {}x{} "
+          "views, layout {}{} ({}), live",
+          input_, hello->message.slot, width_, height_, regions_.left.width, regions_.left.height,
+          to_string(decision.layout), decision.swap_eyes ? " swapped" : "", to_string(decision.rule));
+    } else {
+      regions_.left = regions_.right = {0, 0, width_, height_};
+      regions_.display_aspect = static_cast<double>(width_) / height_;
+      if (r.layout && !r.quiet)
+        fmt::print(stderr,
+                   "nelf: {}: the game gives each eye on its own; --layout {} is for a game that draws one "
+                   "picture\n",
+                   printable(input_), to_string(*r.layout));
+      description_ = fmt::format("{}: a quad-buffer OpenGL game, two {}x{} eyes{}, live", input_, width_, height_,
+                                 swap_ ? " swapped" : "");
+    }
+    if (r.known_depth && !picture_) {
       protocol::Message want;
       want.type = protocol::MessageType::want_depth;
       depth_ = ::send(link_.get(), &want, sizeof want, MSG_NOSIGNAL) == static_cast<ssize_t>(sizeof want);
     }
     origin_ = std::chrono::steady_clock::now();
-    description_ = fmt::format("{}: a quad-buffer OpenGL game, two {}x{} eyes{}, live", input_, width_, height_,
-                               swap_ ? " swapped" : "");
     if (!r.quiet) fmt::print(stderr, "nelf: {}\n", printable(description_));
   }
 
@@ -150,7 +177,7 @@ class GlxStereoSource final : public Source {
     info.frame_rate = 60;  // what a game aims at; play measures the game's own period as it goes
     info.live = true;
     info.description = description_;
-    info.view = {width_, height_, static_cast<double>(width_) / height_};
+    info.view = {regions_.left.width, regions_.left.height, regions_.display_aspect};
     return info;
   }
 
@@ -198,7 +225,7 @@ class GlxStereoSource final : public Source {
 
   ViewFormat negotiate(const ViewFormat& wanted) override {
     const auto& [bx, by] = wanted.block;
-    const bool fits = bx >= 1 && by >= 1 && bx <= width_ && by <= height_;
+    const bool fits = bx >= 1 && by >= 1 && bx <= regions_.left.width && by <= regions_.left.height;
     block_ = fits ? wanted.block : std::array<int, 2>{1, 1};
     return {block_};
   }
@@ -220,22 +247,29 @@ class GlxStereoSource final : public Source {
     if (before % 2 != 0 || head->frame != message.frame) return std::nullopt;
     const std::size_t eye = protocol::eye_bytes(w, h);
     const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(w) * 4;
-    // GL's rows are bottom-up: the view's top row is the last one.
-    const auto view = [&](int i) {
+    // GL's rows are bottom-up: a region's top row is its last one. A picture's views are regions
+    // of its one image; a quad-buffer game's eyes each a whole image of their own.
+    const auto view = [&](int i, const PixelRect& region) {
       const unsigned char* rows = slot + protocol::kSlotHeader + static_cast<std::size_t>(i) * eye;
-      return rgba8_block_means(rows + (height_ - 1) * stride, -stride, width_, height_, block_);
+      return rgba8_block_means(rows + (height_ - 1 - region.y) * stride + static_cast<std::ptrdiff_t>(region.x) * 4,
+                               -stride, region.width, region.height, block_);
     };
     StereoVideoFrame frame;
     frame.bits = 8;
-    frame.left = view(swap_ ? 1 : 0);
-    frame.right = view(swap_ ? 0 : 1);
+    if (picture_) {
+      frame.left = view(0, regions_.left);
+      frame.right = view(0, regions_.right);
+    } else {
+      frame.left = view(swap_ ? 1 : 0, regions_.left);
+      frame.right = view(swap_ ? 0 : 1, regions_.right);
+    }
     if (depth_ && head->depth == 1) frame.disparity = disparity(slot);
     std::atomic_thread_fence(std::memory_order_acquire);
     if (std::atomic_ref<std::uint64_t>(head->sequence).load(std::memory_order_relaxed) != before) return std::nullopt;
-    frame.width = width_;
-    frame.height = height_;
+    frame.width = regions_.left.width;
+    frame.height = regions_.left.height;
     frame.block = block_;
-    frame.aspect = static_cast<double>(width_) / height_;
+    frame.aspect = regions_.display_aspect;
     const auto now = std::chrono::steady_clock::now();
     frame.pts_s = std::chrono::duration<double>(now - origin_).count();
     frame.captured_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
@@ -290,7 +324,9 @@ class GlxStereoSource final : public Source {
   bool said_depth_ = false;
   UniqueFd link_;
   std::unique_ptr<unsigned char, Unmap> shared_;
-  int width_ = 0, height_ = 0;
+  int width_ = 0, height_ = 0;  // each eye's, or the picture's
+  bool picture_ = false;        // a game that draws one picture: its window's, split by its layout
+  ViewRegions regions_;         // where the views are (a quad-buffer game's: each eye whole)
   std::chrono::steady_clock::time_point origin_;
   std::string description_;
   std::atomic<bool> interrupted_{false};
@@ -305,8 +341,10 @@ class GlxStereoSource final : public Source {
 bool accepts_glx_stereo(const SourceRequest& request) { return is_glx_stereo_spec(request.input); }
 
 std::unique_ptr<Source> open_glx_stereo(const SourceRequest& request) {
-  if (request.layout)
-    throw UserError(fmt::format("--layout does not apply to {}: the game gives each eye on its own", request.input), 2);
+  if (request.layout == StereoLayout::alt || request.layout == StereoLayout::pair)
+    throw UserError(fmt::format("layout {} needs a file; a game's picture shows both views in one frame",
+                                to_string(*request.layout)),
+                    2);
   return std::make_unique<GlxStereoSource>(request);
 }
 

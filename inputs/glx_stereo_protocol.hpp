@@ -3,10 +3,12 @@
 // `glx-stereo:` source say to each other over a Unix stream socket, and how the eyes lie in the
 // shared memory it passes. Plain C++ without nelf's other headers: the interposer includes it too.
 //
-// The game's side connects to $NELF_GLX_STEREO_SOCKET at its first buffer swap and sends a hello:
-// stereo (it drew into GL_BACK_RIGHT, so the interposer keeps each eye's back buffer) with a memfd
-// of kSlots frame slots attached (SCM_RIGHTS), or mono (then it closes: nelf captures the window).
-// Then one frame message per swap, naming the slot just written. nelf may answer once with
+// The game's side connects to $NELF_GLX_STEREO_SOCKET at its first buffer swap and sends a hello
+// with a memfd of kSlots frame slots attached (SCM_RIGHTS): stereo (it drew into GL_BACK_RIGHT, so
+// the interposer keeps each eye's back buffer; a slot holds both eyes), or mono, for a game that
+// draws one picture (after a few swaps without a right buffer; a slot holds the window's picture
+// where a left eye goes, and nelf splits it by its layout). A new window, or a new size, is a new
+// link. Then one frame message per swap, naming the slot just written. nelf may answer once with
 // want_depth (it composites with the game's depth, `--depth auto`): from then on each slot also
 // holds both eyes' depth buffers. While nelf shows the frames on a display that refreshes at a fixed
 // rate (play, run) it sends a refresh message at each refresh: its time, the period, and how long
@@ -24,7 +26,7 @@
 
 namespace nelf::glx_stereo {
 
-inline constexpr std::uint32_t kMagic = 0x4e4c4633;  // "NLF3"
+inline constexpr std::uint32_t kMagic = 0x4e4c4634;  // "NLF4"
 inline constexpr int kSlots = 3;
 inline constexpr const char* kSocketVariable = "NELF_GLX_STEREO_SOCKET";
 
@@ -36,7 +38,7 @@ struct Message {
   std::uint32_t stereo = 0;  // hello: 1 when the game draws both eyes
   std::uint32_t width = 0;   // hello: each eye's size in pixels
   std::uint32_t height = 0;
-  std::uint32_t slot = 0;       // frame: the slot just written
+  std::uint32_t slot = 0;       // frame: the slot just written; hello: the game's process id
   std::uint64_t frame = 0;      // frame: the game's swap count, from 0
   std::int64_t swapped_ns = 0;  // frame: CLOCK_MONOTONIC when the game asked to swap
   std::int64_t refresh_ns = 0;  // refresh: CLOCK_MONOTONIC when one of nelf's refreshes began

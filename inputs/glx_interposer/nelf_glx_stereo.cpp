@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -69,11 +70,25 @@ namespace {
 
 namespace protocol = nelf::glx_stereo;
 
-// The mono verdict (glXSwapBuffers): said yet, and the swaps it waited for.
-bool g_said_mono = false;
+// A game that draws one picture (glXSwapBuffers): the swaps waited for before it is taken as one,
+// then its window's picture at each swap, read from the back buffer as a quad-buffer game's eyes
+// are (nelf splits it by its layout). One window at a time: the one shown is the first that
+// swaps; the game's next window takes its place when the context drawing the shown one is
+// destroyed (toolkits open a new display connection, whose window may have the same XID) or the
+// shown one has not swapped for half a second. Swaps come from the game's drawing thread.
 int g_mono_swaps = 0;
 std::int64_t g_first_swap_ns = 0;
-NelfLink g_verdict;
+struct Picture {
+  NelfLink link;
+  GLXContext context = nullptr;
+  GLXDrawable drawable = 0;
+  int width = 0, height = 0;
+  std::uint64_t swaps = 0;
+  std::int64_t last_swap_ns = 0;
+  std::int64_t returned_ns = 0;  // when the last swap of its window returned to the game (0: none yet)
+  bool window_unpaced = false;   // the driver's swap interval set to 0: nelf's refreshes pace the game
+};
+Picture g_picture;
 
 // This thread's context is now `context`, drawing into `drawable` (both make-current calls).
 void made_current(Display* display, GLXDrawable drawable, GLXContext context) {
@@ -179,12 +194,36 @@ void activate(Eyes& e) {
   bind_read(e);
 }
 
+// glReadPixels into tightly packed client memory while it lives, whatever the game set (a pixel
+// pack buffer, row length, alignment, skips): the game's settings come back after.
+class TightPacking {
+ public:
+  TightPacking() {
+    NELF_REAL_GL(glGetIntegerv);
+    real_glGetIntegerv(GL_PIXEL_PACK_BUFFER_BINDING, &pack_buffer_);
+    for (std::size_t i = 0; i < kStore.size(); ++i) real_glGetIntegerv(kStore[i], &saved_[i]);
+    set(0, {4, 0, 0, 0});
+  }
+  ~TightPacking() { set(static_cast<GLuint>(pack_buffer_), saved_); }
+  TightPacking(const TightPacking&) = delete;
+  TightPacking& operator=(const TightPacking&) = delete;
+
+ private:
+  static constexpr std::array<GLenum, 4> kStore{GL_PACK_ALIGNMENT, GL_PACK_ROW_LENGTH, GL_PACK_SKIP_ROWS,
+                                                GL_PACK_SKIP_PIXELS};
+  static void set(GLuint buffer, const std::array<GLint, 4>& values) {
+    NELF_REAL_GL(glBindBuffer);
+    NELF_REAL_GL(glPixelStorei);
+    if (real_glBindBuffer) real_glBindBuffer(GL_PIXEL_PACK_BUFFER, buffer);
+    for (std::size_t i = 0; i < kStore.size(); ++i) real_glPixelStorei(kStore[i], values[i]);
+  }
+  GLint pack_buffer_ = 0;
+  std::array<GLint, 4> saved_{};
+};
+
 // Both eyes into the next shared slot, rows bottom-up as GL reads them, and their depth buffers
 // when nelf wants them.
 void send_eyes(Eyes& e, std::int64_t swapped_ns) {
-  NELF_REAL_GL(glGetIntegerv);
-  NELF_REAL_GL(glPixelStorei);
-  NELF_REAL_GL(glBindBuffer);
   NELF_REAL_GL(glBindFramebuffer);
   NELF_REAL_GL(glReadPixels);
   if (!e.link.connected() &&
@@ -192,17 +231,7 @@ void send_eyes(Eyes& e, std::int64_t swapped_ns) {
     return;
   unsigned char* slot = e.link.begin_slot(e.swaps);
   if (!slot) return;
-  GLint pack_buffer = 0, alignment = 0, row_length = 0, skip_rows = 0, skip_pixels = 0;
-  real_glGetIntegerv(GL_PIXEL_PACK_BUFFER_BINDING, &pack_buffer);
-  real_glGetIntegerv(GL_PACK_ALIGNMENT, &alignment);
-  real_glGetIntegerv(GL_PACK_ROW_LENGTH, &row_length);
-  real_glGetIntegerv(GL_PACK_SKIP_ROWS, &skip_rows);
-  real_glGetIntegerv(GL_PACK_SKIP_PIXELS, &skip_pixels);
-  real_glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-  real_glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  real_glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-  real_glPixelStorei(GL_PACK_SKIP_ROWS, 0);
-  real_glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
+  const TightPacking packing;
   const std::size_t eye_bytes =
       protocol::eye_bytes(static_cast<std::uint32_t>(e.width), static_cast<std::uint32_t>(e.height));
   for (int i = 0; i < 2; ++i) {
@@ -218,12 +247,78 @@ void send_eyes(Eyes& e, std::int64_t swapped_ns) {
         slot + protocol::depth_offset(static_cast<std::uint32_t>(e.width), static_cast<std::uint32_t>(e.height), i));
   }
   reinterpret_cast<protocol::SlotHeader*>(slot)->depth = depth ? 1 : 0;
-  real_glBindBuffer(GL_PIXEL_PACK_BUFFER, static_cast<GLuint>(pack_buffer));
-  real_glPixelStorei(GL_PACK_ALIGNMENT, alignment);
-  real_glPixelStorei(GL_PACK_ROW_LENGTH, row_length);
-  real_glPixelStorei(GL_PACK_SKIP_ROWS, skip_rows);
-  real_glPixelStorei(GL_PACK_SKIP_PIXELS, skip_pixels);
   e.link.end_slot(slot, e.swaps, swapped_ns);
+}
+
+// The window's picture into the next shared slot (where a left eye goes), rows bottom-up, read
+// from the back buffer the swap is about to show.
+void send_picture(Picture& p, std::int64_t swapped_ns) {
+  NELF_REAL_GL(glGetIntegerv);
+  NELF_REAL_GL(glBindFramebuffer);
+  NELF_REAL_GL(glReadBuffer);
+  NELF_REAL_GL(glReadPixels);
+  unsigned char* slot = p.link.begin_slot(p.swaps);
+  if (!slot) return;
+  GLint read_framebuffer = 0, read_buffer = GL_BACK;
+  if (real_glBindFramebuffer) real_glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &read_framebuffer);
+  real_glGetIntegerv(GL_READ_BUFFER, &read_buffer);
+  {
+    const TightPacking packing;
+    if (real_glBindFramebuffer) real_glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    real_glReadBuffer(GL_BACK);
+    real_glReadPixels(0, 0, p.width, p.height, GL_RGBA, GL_UNSIGNED_BYTE, slot + protocol::kSlotHeader);
+  }
+  if (read_framebuffer == 0) real_glReadBuffer(static_cast<GLenum>(read_buffer));
+  if (real_glBindFramebuffer) real_glBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(read_framebuffer));
+  if (read_framebuffer != 0) real_glReadBuffer(static_cast<GLenum>(read_buffer));
+  p.link.read_messages();
+  reinterpret_cast<protocol::SlotHeader*>(slot)->depth = 0;
+  p.link.end_slot(slot, p.swaps, swapped_ns);
+}
+
+// A swap of a game that draws one picture: the picture to nelf, and with a swap interval the swap
+// returns in time for nelf's refresh, as for a quad-buffer game.
+void swap_picture(Display* dpy, GLXDrawable drawable) {
+  NELF_REAL_GLX(glXSwapBuffers);
+  NELF_REAL_GLX(glXQueryDrawable);
+  NELF_REAL_GLX(glXGetCurrentContext);
+  Picture& p = g_picture;
+  const std::int64_t swapped_ns = monotonic_ns();
+  if (p.link.connected() && drawable != p.drawable && swapped_ns - p.last_swap_ns >= 500'000'000)
+    p.link.close();  // the window shown stopped swapping: the game's next window takes its place
+  const bool shown = !p.link.connected() || drawable == p.drawable;
+  if (shown) {
+    unsigned width = 0, height = 0;
+    real_glXQueryDrawable(dpy, drawable, GLX_WIDTH, &width);
+    real_glXQueryDrawable(dpy, drawable, GLX_HEIGHT, &height);
+    // A resized window: nelf is told the new size on a new link.
+    if (p.link.connected() && (static_cast<int>(width) != p.width || static_cast<int>(height) != p.height))
+      p.link.close();
+    if (!p.link.connected() && width > 0 && height > 0 && p.link.connect(false, width, height)) {
+      p.context = real_glXGetCurrentContext();
+      p.drawable = drawable;
+      p.width = static_cast<int>(width);
+      p.height = static_cast<int>(height);
+      p.window_unpaced = false;
+    }
+    if (p.link.connected()) {
+      send_picture(p, swapped_ns);
+      p.last_swap_ns = swapped_ns;
+    }
+  }
+  const int interval = swap_interval();
+  const bool paced = shown && interval > 0 && p.link.linked_for_frames();
+  const std::int64_t game_ns = p.returned_ns != 0 ? swapped_ns - p.returned_ns : 0;  // its last frame's drawing
+  if (paced && !p.window_unpaced) {
+    driver_swap_interval(dpy, drawable, 0);
+    p.window_unpaced = true;
+  }
+  real_glXSwapBuffers(dpy, drawable);
+  if (!shown) return;
+  const std::int64_t returns = paced ? p.link.swap_returns_ns(monotonic_ns(), interval, game_ns, p.returned_ns) : 0;
+  ++p.swaps;
+  if (returns != 0) sleep_until_ns(returns);
+  p.returned_ns = monotonic_ns();
 }
 
 // The left eye into the window's back buffer: what the game's own window shows.
@@ -321,6 +416,7 @@ __attribute__((visibility("default"))) void glXDestroyContext(Display* dpy, GLXC
       if (t_current == &it->second) t_current = nullptr;
       contexts().erase(it);  // its framebuffers go with the context
     }
+    if (g_picture.link.connected() && g_picture.context == context) g_picture.link.close();  // its window closes
   }
   real_glXDestroyContext(dpy, context);
 }
@@ -329,26 +425,25 @@ __attribute__((visibility("default"))) void glXSwapBuffers(Display* dpy, GLXDraw
   NELF_REAL_GLX(glXSwapBuffers);
   Eyes* e = t_current;
   if (!e || !e->active || e->drawable != drawable) {
-    // A game that draws one picture: nelf is told once, and captures its window. Toolkits swap
-    // before the game draws: that verdict waits for 5 swaps and a fifth of a second of them (a
-    // quad-buffer game draws both eyes from its first frame; nelf waits for the window meanwhile).
-    if (e && !e->active && !g_said_mono) {
+    // A game that draws one picture: its picture goes to nelf at each swap. Toolkits swap before
+    // the game draws: that waits for 5 swaps and a fifth of a second of them (a quad-buffer game
+    // draws both eyes from its first frame).
+    if (e && !e->active) {
       const std::int64_t now = monotonic_ns();
       if (g_mono_swaps++ == 0) g_first_swap_ns = now;
-      if (g_mono_swaps >= 5 && now - g_first_swap_ns >= 200'000'000) {
-        g_said_mono = g_verdict.connect(false, 0, 0);  // at most twice a second until nelf hears it
-        g_verdict.close();
-      }
+      if (g_mono_swaps >= 5 && now - g_first_swap_ns >= 200'000'000) return swap_picture(dpy, drawable);
     }
     real_glXSwapBuffers(dpy, drawable);
     return;
   }
+  // A game that drew one picture, then both eyes: nelf is told on a new link, for the eyes.
+  if (g_picture.link.connected()) g_picture.link.close();
   const std::int64_t swapped_ns = monotonic_ns();
   send_eyes(*e, swapped_ns);
   show_left_eye(*e);
   const int interval = swap_interval();
   const std::int64_t game_ns = e->returned_ns != 0 ? swapped_ns - e->returned_ns : 0;  // its last frame's drawing
-  const bool paced = interval > 0 && e->link.linked_for_stereo();
+  const bool paced = interval > 0 && e->link.linked_for_frames();
   if (paced && !e->window_unpaced) {
     driver_swap_interval(dpy, drawable, 0);
     e->window_unpaced = true;

@@ -33,8 +33,9 @@ bool NelfLink::connect(bool stereo, std::uint32_t width, std::uint32_t height) {
   hello.stereo = stereo ? 1 : 0;
   hello.width = width;
   hello.height = height;
+  hello.slot = static_cast<std::uint32_t>(::getpid());
   int memory = -1;
-  if (stereo) {
+  if (width > 0 && height > 0) {
     bytes_ = protocol::shared_bytes(width, height);
     memory = memfd_create("nelf-glx-stereo", MFD_CLOEXEC);
     if (memory < 0 || ftruncate(memory, static_cast<off_t>(bytes_)) != 0) {

@@ -27,11 +27,12 @@ class NelfLink {
 
   bool connected() const { return fd_ >= 0; }
 
-  // Connects and says hello; stereo links get shared memory for eyes of width × height. At most
-  // twice a second, so that a game without nelf listening loses nothing.
+  // Connects and says hello; with a size, the link gets shared memory for eyes of width × height
+  // (stereo) or for the window's picture of that size (mono). At most twice a second, so that a
+  // game without nelf listening loses nothing.
   bool connect(bool stereo, std::uint32_t width, std::uint32_t height);
 
-  // The slot for `frame`, marked as being written; nullptr when not linked for stereo.
+  // The slot for `frame`, marked as being written; nullptr when the link has no shared memory.
   unsigned char* begin_slot(std::uint64_t frame);
 
   void end_slot(unsigned char* slot, std::uint64_t frame, std::int64_t swapped_ns);
@@ -40,7 +41,7 @@ class NelfLink {
   // (it composites with the game's depth; once asked, always), and its newest refresh.
   void read_messages();
   bool depth_wanted() const { return depth_wanted_; }
-  bool linked_for_stereo() const { return fd_ >= 0 && shared_ != nullptr; }
+  bool linked_for_frames() const { return fd_ >= 0 && shared_ != nullptr; }
 
   // When a swap made at `now` returns (protocol::vsync_returns_ns); 0: at once.
   std::int64_t swap_returns_ns(std::int64_t now, int interval, std::int64_t game_ns,

@@ -1,7 +1,8 @@
 // The glx-stereo: source against the test game in quad-buffer mode on a private Xvfb with Mesa, which
 // has no stereo visuals: without nelf's interposer the game cannot open its window; with it
 // (LD_PRELOAD, as `nelf run` starts games) both eyes arrive, each its own, frame after frame,
-// through GLFW and through SDL2. A game that draws one picture, and one that never swaps, are said.
+// through GLFW and through SDL2. A game that draws one picture gives that picture's views the same
+// way; one that never swaps is said.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -172,11 +173,51 @@ TEST_F(GlxStereoSourceTest, DlsymRtldNextStillMeansAfterTheCaller) {
   EXPECT_EQ(preloaded.out, glx_stereo_library_path() + "\n");
 }
 
-TEST_F(GlxStereoSourceTest, AGameThatDrawsOnePictureOrNeverSwapsIsSaid) {
-  {
-    test::TestGame game({"--mode", "sbs", "--size", "320x180", "--fps", "30"}, interposed());
-    EXPECT_THROW(open_source(quiet_request("glx-stereo:wait=20,socket=" + socket())), GameDrawsOnePicture);
+TEST_F(GlxStereoSourceTest, AGameThatDrawsOnePictureGivesItsViewsAtEachSwap) {
+  // Both eyes side by side, top and bottom, frame-packed: the layout found as for a file, through
+  // GLFW and SDL2; the views are the game's, upright, the newest frame each time.
+  struct Case {
+    const char* toolkit;
+    const char* mode;
+    std::optional<StereoLayout> layout;
+    int view_w, view_h;
+    const char* said;
+  };
+  for (const Case& c : {Case{"glfw", "sbs", std::nullopt, 320, 180, "layout sbs (aspect)"},
+                        Case{"sdl2", "tab", std::nullopt, 320, 180, "layout tab (aspect)"},
+                        Case{"glfw", "fp", std::nullopt, 1280, 720, "layout fp (frame-size)"},
+                        Case{"sdl2", "sbs-half", StereoLayout::sbs_half, 160, 180, "layout sbs-half (flag)"}}) {
+    SCOPED_TRACE(c.mode);
+    const std::string size = std::string(c.mode) == "fp" ? "1280x720" : "320x180";
+    test::TestGame game({"--toolkit", c.toolkit, "--mode", c.mode, "--size", size, "--fps", "30"}, interposed());
+    auto source = open_source(quiet_request("glx-stereo:wait=20,socket=" + socket(), c.layout));
+    const SourceInfo info = source->info();
+    EXPECT_TRUE(info.live);
+    EXPECT_EQ(info.view.width, c.view_w);
+    EXPECT_EQ(info.view.height, c.view_h);
+    EXPECT_NE(info.description.find("the window of an OpenGL game (process "), std::string::npos) << info.description;
+    EXPECT_NE(info.description.find(c.said), std::string::npos) << info.description;
+    std::optional<std::uint32_t> last;
+    for (int i = 0; i < 6; ++i) {
+      const std::optional<StereoVideoFrame> f = source->next();
+      ASSERT_TRUE(f);
+      ASSERT_EQ(f->width, c.view_w);
+      ASSERT_EQ(f->height, c.view_h);
+      EXPECT_GT(f->captured_ns, 0);
+      EXPECT_NE(f->left, f->right);  // the bars at opposite disparities
+      const auto left = read_frame_stamp(f->left.data(), f->width, f->height, f->bits);
+      const auto right = read_frame_stamp(f->right.data(), f->width, f->height, f->bits);
+      ASSERT_TRUE(left && right) << "frame " << i;  // a flipped or misplaced view reads as no stamp
+      EXPECT_EQ(*left, *right);
+      if (last) {
+        EXPECT_GT(left->frame, *last);
+      }
+      last = left->frame;
+    }
   }
+}
+
+TEST_F(GlxStereoSourceTest, AGameThatNeverSwapsIsSaid) {
   try {
     open_source(quiet_request("glx-stereo:wait=0.5,socket=" + socket()));
     FAIL() << "no game, yet a source";
@@ -191,7 +232,13 @@ TEST_F(GlxStereoSourceTest, AGameThatDrawsOnePictureOrNeverSwapsIsSaid) {
     EXPECT_EQ(e.status(), 2);
     EXPECT_NE(std::string(e.what()).find("socket=PATH is missing"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(open_source(quiet_request("glx-stereo:socket=" + socket(), StereoLayout::sbs)), UserError);
+  try {
+    open_source(quiet_request("glx-stereo:socket=" + socket(), StereoLayout::alt));
+    FAIL() << "a layout of two frames, yet a source";
+  } catch (const UserError& e) {
+    EXPECT_EQ(e.status(), 2);
+    EXPECT_NE(std::string(e.what()).find("layout alt needs a file"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(GlxStereoSourceTest, WhatTheGameDrawsIntoBothBackBuffersIsInBothEyes) {
