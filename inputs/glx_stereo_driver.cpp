@@ -137,16 +137,9 @@ class GlxStereoSource final : public Source {
     shared_ = std::unique_ptr<unsigned char, Unmap>(static_cast<unsigned char*>(mapped), Unmap{bytes});
     if (picture_) {
       // Its two views are where its layout puts them, as in a captured window.
-      LayoutEvidence evidence{r.layout, std::nullopt, width_, height_, {}};
-      evidence.swap_eyes = r.swap_eyes;
-      const LayoutDecision decision = detect_stereo_layout(evidence);
-      try {
-        regions_ = view_regions(decision.layout, width_, height_, decision.swap_eyes);
-      } catch (const LayoutError& e) {
-        throw UserError(fmt::format("{}: {}", printable(input_), e.what()), 2);
-      }
-      if (!decision.warning.empty() && !r.quiet)
-        fmt::print(stderr, "nelf: warning: {}: {}\n", printable(input_), printable(decision.warning));
+      const LivePictureViews views = live_picture_views(input_, r.layout, r.swap_eyes, width_, height_, r.quiet);
+      const LayoutDecision& decision = views.decision;
+      regions_ = views.regions;
       description_ = fmt::format(
           "{}: the window of an OpenGL game (process {}), {}x{} read at each swap, two {}x{} "
           "views, layout {}{} ({}), live",

@@ -35,16 +35,9 @@ class LiveCaptureSource final : public Source {
     width_ = first_->width;
     height_ = first_->height;
     origin_ = first_->captured_at;
-    LayoutEvidence evidence{r.layout, std::nullopt, width_, height_, {}};
-    evidence.swap_eyes = r.swap_eyes;
-    decision_ = detect_stereo_layout(evidence);
-    try {
-      regions_ = view_regions(decision_.layout, width_, height_, decision_.swap_eyes);
-    } catch (const LayoutError& e) {
-      throw UserError(fmt::format("{}: {}", printable(input_), e.what()), 2);
-    }
-    if (!decision_.warning.empty() && !r.quiet)
-      fmt::print(stderr, "nelf: warning: {}: {}\n", printable(input_), printable(decision_.warning));
+    LivePictureViews views = live_picture_views(input_, r.layout, r.swap_eyes, width_, height_, r.quiet);
+    decision_ = views.decision;
+    regions_ = views.regions;
     description_ =
         fmt::format("{}: {}, {}x{}, live, two {}x{} views, layout {}{} ({})", input_, capture_->description(), width_,
                     height_, regions_.left.width, regions_.left.height, to_string(decision_.layout),

@@ -1,7 +1,11 @@
 #include "inputs/view_regions.hpp"
 
 #include <fmt/format.h>
+#include <cstdio>
 #include <utility>
+
+#include "core/printable.hpp"
+#include "core/user_error.hpp"
 
 namespace nelf {
 
@@ -54,6 +58,22 @@ ViewRegions view_regions(StereoLayout layout, int width, int height, bool swap_e
   }
   if (swap_eyes) std::swap(r.left, r.right);
   return r;
+}
+
+LivePictureViews live_picture_views(const std::string& input, std::optional<StereoLayout> layout, bool swap_eyes,
+                                    int width, int height, bool quiet) {
+  LayoutEvidence evidence{layout, std::nullopt, width, height, {}};
+  evidence.swap_eyes = swap_eyes;
+  LivePictureViews out;
+  out.decision = detect_stereo_layout(evidence);
+  try {
+    out.regions = view_regions(out.decision.layout, width, height, out.decision.swap_eyes);
+  } catch (const LayoutError& e) {
+    throw UserError(fmt::format("{}: {}", printable(input), e.what()), 2);
+  }
+  if (!out.decision.warning.empty() && !quiet)
+    fmt::print(stderr, "nelf: warning: {}: {}\n", printable(input), printable(out.decision.warning));
+  return out;
 }
 
 }  // namespace nelf

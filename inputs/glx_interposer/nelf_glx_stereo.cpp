@@ -428,7 +428,8 @@ __attribute__((visibility("default"))) void glXSwapBuffers(Display* dpy, GLXDraw
     // A game that draws one picture: its picture goes to nelf at each swap. Toolkits swap before
     // the game draws: that waits for 5 swaps and a fifth of a second of them (a quad-buffer game
     // draws both eyes from its first frame).
-    if (e && !e->active) {
+    // (The picture is read from the current context's drawable: a swap of another is passed on.)
+    if (e && !e->active && e->drawable == drawable) {
       const std::int64_t now = monotonic_ns();
       if (g_mono_swaps++ == 0) g_first_swap_ns = now;
       if (g_mono_swaps >= 5 && now - g_first_swap_ns >= 200'000'000) return swap_picture(dpy, drawable);

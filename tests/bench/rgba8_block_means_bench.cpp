@@ -32,16 +32,12 @@ int main(int argc, char** argv) {
   std::uint8_t* dst[4] = {out.data(), nullptr, nullptr, nullptr};
   const int dst_stride[4] = {out_w * 4, 0, 0, 0};
 
-  std::vector<double> swscale_ms, own_ms;
-  for (int i = 0; i <= runs; ++i) {  // interleaved; the first of each is dropped
-    const double s = nelf::bench::elapsed_ms([&] { sws_scale(sws, src, src_stride, 0, height, dst, dst_stride); });
-    const double o = nelf::bench::elapsed_ms([&] {
-      means = nelf::rgba8_block_means(top_row, -width * 4, width, height, {2, 2});
-    });
-    if (i > 0) swscale_ms.push_back(s), own_ms.push_back(o);
-  }
+  const auto [s, o] = nelf::bench::interleaved_medians(
+      runs, [&] { sws_scale(sws, src, src_stride, 0, height, dst, dst_stride); },
+      [&] {
+        means = nelf::rgba8_block_means(top_row, -width * 4, width, height, {2, 2});
+      });
   sws_freeContext(sws);
-  const double s = nelf::bench::median(swscale_ms), o = nelf::bench::median(own_ms);
   std::printf("one 1280x720 RGBA8 eye, bottom-up, to 640x360 block means, median of %d runs\n", runs);
   std::printf("swscale (SWS_AREA)  %7.3f ms\n", s);
   std::printf("rgba8_block_means   %7.3f ms\n", o);

@@ -38,15 +38,10 @@ int main(int argc, char** argv) {
   const nelf::Yuv420Planes planes{
       .y = y.data(), .u = u.data(), .v = v.data(), .y_stride = width, .u_stride = width / 2, .v_stride = width / 2};
 
-  std::vector<double> swscale_ms, own_ms;
-  for (int i = 0; i <= runs; ++i) {  // interleaved; the first of each is dropped
-    const double s = nelf::bench::elapsed_ms([&] { sws_scale(sws, src, src_stride, 0, height, dst, dst_stride); });
-    const double o = nelf::bench::elapsed_ms(
-        [&] { nelf::yuv420_block_means(planes, width, height, bx, by, matrix, out.data(), out_w * 4); });
-    if (i > 0) swscale_ms.push_back(s), own_ms.push_back(o);
-  }
+  const auto [s, o] = nelf::bench::interleaved_medians(
+      runs, [&] { sws_scale(sws, src, src_stride, 0, height, dst, dst_stride); },
+      [&] { nelf::yuv420_block_means(planes, width, height, bx, by, matrix, out.data(), out_w * 4); });
   sws_freeContext(sws);
-  const double s = nelf::bench::median(swscale_ms), o = nelf::bench::median(own_ms);
   std::printf("one 960x1080 eye to 480x270 RGBA8 block means, median of %d runs\n", runs);
   std::printf("swscale (SWS_AREA, full chroma) %7.3f ms\n", s);
   std::printf("yuv420_block_means              %7.3f ms\n", o);
