@@ -315,6 +315,20 @@ TEST_F(LiveCliTest, RunEndsWithTheGamesStatus) {
   EXPECT_NE(none.err.find("nelf run [options] -- GAME [ARGS...]"), std::string::npos) << none.err;
 }
 
+// The game keeps its freed memory for reuse (glibc's tunables), and what the user set still wins.
+TEST_F(LiveCliTest, RunHasTheGameKeepFreedMemoryForReuse) {
+  const auto seen = dir_.path() / "tunables.txt";
+  const std::string ours = "glibc.malloc.mmap_threshold=33554432:glibc.malloc.trim_threshold=268435456";
+  const std::string game = " run --output offscreen -- sh -c " +
+                           shell_quote("printf %s \"$GLIBC_TUNABLES\" > " + shell_quote(seen.string()) + "; exit 3");
+  auto r = run_command("env -u GLIBC_TUNABLES " + std::string(NELF_BINARY) + game);
+  ASSERT_EQ(r.status, 3) << r.err;
+  EXPECT_EQ(test::read_file(seen), ours);
+  r = run_command("env GLIBC_TUNABLES=glibc.malloc.trim_threshold=0 " + std::string(NELF_BINARY) + game);
+  ASSERT_EQ(r.status, 3) << r.err;
+  EXPECT_EQ(test::read_file(seen), ours + ":glibc.malloc.trim_threshold=0");
+}
+
 TEST_F(LiveCliTest, InterruptingRunEndsTheGameToo) {
   const auto r =
       run_command("( " + std::string(NELF_BINARY) + " run --output offscreen -- " + shell_quote(NELF_TEST_GAME) +
