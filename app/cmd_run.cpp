@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "app/freed_memory.hpp"
 #include "app/play_command.hpp"
 #include "core/printable.hpp"
 #include "inputs/glx_stereo_protocol.hpp"
@@ -55,16 +56,6 @@ std::string interposer_socket_path() {
 // from the interposer and waits for its window alone.
 constexpr double kFirstSwapWait_s = 5;
 
-// The game's glibc keeps freed blocks for reuse, as nelf's own main does: Mesa's software OpenGL
-// (llvmpipe, a desktop without a GPU) allocates a frame-sized buffer at each swap, and given back
-// to the kernel each is new pages, every page a fault: half the test game's frame rate in a
-// virtual machine (docs/PERFORMANCE.md, live games). Put before what the user set, which wins.
-std::string game_malloc_tunables() {
-  std::string tunables = "glibc.malloc.mmap_threshold=33554432:glibc.malloc.trim_threshold=268435456";
-  if (const char* before = std::getenv("GLIBC_TUNABLES"); before && *before) tunables += std::string(":") + before;
-  return tunables;
-}
-
 void run_game(const RunArgs& args, const std::vector<std::string>& command) {
   if (args.wait_s <= 0) throw UserError("--wait must be more than 0 seconds", 2);
   // From the start: a Ctrl-C while the game starts or between its windows ends both too.
@@ -76,7 +67,7 @@ void run_game(const RunArgs& args, const std::vector<std::string>& command) {
   std::string preload = glx_stereo_library_path();
   if (const char* before = std::getenv("LD_PRELOAD"); before && *before) preload += std::string(":") + before;
   GameProcess game(command, {"LD_PRELOAD=" + preload, std::string(glx_stereo::kSocketVariable) + "=" + socket,
-                             "GLIBC_TUNABLES=" + game_malloc_tunables()});
+                             "GLIBC_TUNABLES=" + freed_memory_tunables(std::getenv("GLIBC_TUNABLES"))});
   // --window names a window to capture: its picture, whoever draws it, through the X server.
   bool from_interposer = args.window.empty();
   // Stops waiting for the first swap when the user interrupts or the game ends without one.

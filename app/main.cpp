@@ -1,6 +1,5 @@
 // nelf: shows stereo content on near-eye light field displays. See README.md.
 #include <fmt/format.h>
-#include <malloc.h>
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <csignal>
@@ -11,6 +10,7 @@
 #include "app/cli_suggestions.hpp"
 #include "app/commands.hpp"
 #include "app/config_file.hpp"
+#include "app/freed_memory.hpp"
 #include "app/play_command.hpp"
 #include "core/printable.hpp"
 #include "optics/profile.hpp"
@@ -42,14 +42,7 @@ int main(int argc, char** argv) {
   // Ignored, the write fails with EPIPE: a diagnostic write is dropped, and EPIPE on an output
   // (stdout, or any sink writing to a pipe) unwinds like any failure, cleaning up, and ends quietly.
   std::signal(SIGPIPE, SIG_IGN);
-  // A live frame's views are fresh buffers of a megabyte or more, freed a few frames later. glibc
-  // hands such blocks back to the kernel (mmap above its threshold, the heap's top trimmed), so each
-  // frame's buffers were new pages, every one a page fault, ~200 a frame for a game's two eyes, a
-  // few milliseconds on a shared machine before nelf has the frame (docs/PERFORMANCE.md, live games).
-  // Kept in the process, freed blocks are reused: blocks up to 32 MiB (a 4K RGBA8 frame) come from
-  // the heap, and up to 256 MiB free at its top stays there.
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);
-  mallopt(M_TRIM_THRESHOLD, 256 << 20);
+  nelf::app::keep_freed_memory();  // a live frame's buffers reused, not faulted in anew
   CLI::App app;
   nelf::app::build_cli(app);
 
