@@ -242,10 +242,11 @@ class GlxStereoSource final : public Source {
     const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(w) * 4;
     // GL's rows are bottom-up: a region's top row is its last one. A picture's views are regions
     // of its one image; a quad-buffer game's eyes each a whole image of their own.
+    const ByteOrder order = head->bgrx == 1 ? ByteOrder::bgrx : ByteOrder::rgba;
     const auto view = [&](int i, const PixelRect& region) {
       const unsigned char* rows = slot + protocol::kSlotHeader + static_cast<std::size_t>(i) * eye;
       return rgba8_block_means(rows + (height_ - 1 - region.y) * stride + static_cast<std::ptrdiff_t>(region.x) * 4,
-                               -stride, region.width, region.height, block_);
+                               -stride, region.width, region.height, block_, order);
     };
     StereoVideoFrame frame;
     frame.bits = 8;

@@ -26,7 +26,7 @@
 
 namespace nelf::glx_stereo {
 
-inline constexpr std::uint32_t kMagic = 0x4e4c4634;  // "NLF4"
+inline constexpr std::uint32_t kMagic = 0x4e4c4635;  // "NLF5"
 inline constexpr int kSlots = 3;
 inline constexpr const char* kSocketVariable = "NELF_GLX_STEREO_SOCKET";
 
@@ -47,14 +47,16 @@ struct Message {
 };
 static_assert(sizeof(Message) == 64);
 
-// The head of each slot; the left eye's RGBA rows follow at kSlotHeader, then the right eye's, each
-// width × height × 4 bytes, then, when `depth` is 1, the left and the right eye's depth buffers as
-// floats (0..1) of width × height × 4 bytes each; rows bottom-up (as glReadPixels gives them).
+// The head of each slot; the left eye's RGBA (or, when `bgrx` is 1, BGRX) rows follow at
+// kSlotHeader, then the right eye's, each width × height × 4 bytes, then, when `depth` is 1, the
+// left and the right eye's depth buffers as floats (0..1) of width × height × 4 bytes each; rows
+// bottom-up (as glReadPixels gives them).
 struct SlotHeader {
   std::uint64_t sequence;  // odd while the game writes the slot; atomic_ref'd on both sides
   std::uint64_t frame;
   std::int64_t swapped_ns;
   std::uint32_t depth;  // 1: the depth buffers follow the colour
+  std::uint32_t bgrx;   // 1: the colour bytes are B, G, R and one not read (a window's back buffer, as stored)
 };
 inline constexpr std::size_t kSlotHeader = 64;
 

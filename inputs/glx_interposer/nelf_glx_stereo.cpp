@@ -247,11 +247,15 @@ void send_eyes(Eyes& e, std::int64_t swapped_ns) {
         slot + protocol::depth_offset(static_cast<std::uint32_t>(e.width), static_cast<std::uint32_t>(e.height), i));
   }
   reinterpret_cast<protocol::SlotHeader*>(slot)->depth = depth ? 1 : 0;
+  reinterpret_cast<protocol::SlotHeader*>(slot)->bgrx = 0;
   e.link.end_slot(slot, e.swaps, swapped_ns);
 }
 
 // The window's picture into the next shared slot (where a left eye goes), rows bottom-up, read
-// from the back buffer the swap is about to show.
+// from the back buffer the swap is about to show. Read as BGRA, the order the window's pixels are
+// kept in (X visuals): Mesa's software OpenGL then copies the rows, where RGBA took it a pass that
+// swaps every pixel's bytes (2560x720: 0.9 ms against 3.3 ms, time the frame waits to be shown).
+// nelf reorders the block means it makes of them.
 void send_picture(Picture& p, std::int64_t swapped_ns) {
   NELF_REAL_GL(glGetIntegerv);
   NELF_REAL_GL(glBindFramebuffer);
@@ -266,13 +270,14 @@ void send_picture(Picture& p, std::int64_t swapped_ns) {
     const TightPacking packing;
     if (real_glBindFramebuffer) real_glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
     real_glReadBuffer(GL_BACK);
-    real_glReadPixels(0, 0, p.width, p.height, GL_RGBA, GL_UNSIGNED_BYTE, slot + protocol::kSlotHeader);
+    real_glReadPixels(0, 0, p.width, p.height, GL_BGRA, GL_UNSIGNED_BYTE, slot + protocol::kSlotHeader);
   }
   if (read_framebuffer == 0) real_glReadBuffer(static_cast<GLenum>(read_buffer));
   if (real_glBindFramebuffer) real_glBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(read_framebuffer));
   if (read_framebuffer != 0) real_glReadBuffer(static_cast<GLenum>(read_buffer));
   p.link.read_messages();
   reinterpret_cast<protocol::SlotHeader*>(slot)->depth = 0;
+  reinterpret_cast<protocol::SlotHeader*>(slot)->bgrx = 1;
   p.link.end_slot(slot, p.swaps, swapped_ns);
 }
 

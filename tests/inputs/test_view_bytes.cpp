@@ -16,17 +16,19 @@ std::vector<std::uint8_t> pattern(int width, int height) {
 }
 
 // Checks every block's mean of rows stored top-down (stride > 0) or bottom-up (stride < 0).
-void expect_block_means(int width, int height, std::array<int, 2> block, bool bottom_up) {
+void expect_block_means(int width, int height, std::array<int, 2> block, bool bottom_up,
+                        nelf::ByteOrder order = nelf::ByteOrder::rgba) {
   const std::vector<std::uint8_t> rgba = pattern(width, height);
   const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(width) * 4;
   // The view's row y: stored at row y (top-down) or height - 1 - y (bottom-up).
   const auto at = [&](int x, int y, int c) {
     const int stored = bottom_up ? height - 1 - y : y;
+    if (order == nelf::ByteOrder::bgrx && c != 3) c = 2 - c;  // R is stored third, B first
     return rgba[static_cast<std::size_t>(stored) * width * 4 + static_cast<std::size_t>(x) * 4 + c];
   };
   const std::uint8_t* top = bottom_up ? rgba.data() + (height - 1) * stride : rgba.data();
   const std::vector<std::uint8_t> out =
-      nelf::rgba8_block_means(top, bottom_up ? -stride : stride, width, height, block);
+      nelf::rgba8_block_means(top, bottom_up ? -stride : stride, width, height, block, order);
   const int w = width / block[0], h = height / block[1];
   ASSERT_EQ(out.size(), static_cast<std::size_t>(w) * h * 4);
   for (int y = 0; y < h; ++y)
@@ -55,6 +57,14 @@ TEST(ViewBytes, BlockMeansAreEachBlocksMeanRoundedWithTheViewsTopRowFirst) {
   }
 }
 
+TEST(ViewBytes, BlockMeansOfBgrxRowsComeOutRgba) {
+  for (const bool bottom_up : {false, true}) {
+    SCOPED_TRACE(bottom_up ? "bottom-up" : "top-down");
+    expect_block_means(64, 36, {2, 2}, bottom_up, nelf::ByteOrder::bgrx);
+    expect_block_means(66, 37, {3, 2}, bottom_up, nelf::ByteOrder::bgrx);
+  }
+}
+
 TEST(ViewBytes, AOneByOneBlockCopiesTheRows) {
   const int width = 8, height = 5;
   const std::vector<std::uint8_t> rgba = pattern(width, height);
@@ -66,4 +76,26 @@ TEST(ViewBytes, AOneByOneBlockCopiesTheRows) {
   for (int y = 0; y < height; ++y)
     EXPECT_TRUE(std::equal(flipped.begin() + y * stride, flipped.begin() + (y + 1) * stride,
                            rgba.begin() + (height - 1 - y) * stride));
+}
+
+TEST(ViewBytes, AOneByOneBlockOfBgrxRowsSwapsRedAndBlueWithAlpha255) {
+  const int width = 8, height = 5;
+  const std::vector<std::uint8_t> bgrx = pattern(width, height);
+  const std::ptrdiff_t stride = width * 4;
+  for (const bool bottom_up : {false, true}) {
+    SCOPED_TRACE(bottom_up ? "bottom-up" : "top-down");
+    const std::uint8_t* top = bottom_up ? bgrx.data() + (height - 1) * stride : bgrx.data();
+    const std::vector<std::uint8_t> rgba =
+        nelf::rgba8_block_means(top, bottom_up ? -stride : stride, width, height, {1, 1}, nelf::ByteOrder::bgrx);
+    ASSERT_EQ(rgba.size(), bgrx.size());
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const std::uint8_t* in = &bgrx[static_cast<std::size_t>(bottom_up ? height - 1 - y : y) * stride + x * 4];
+        const std::uint8_t* out = &rgba[static_cast<std::size_t>(y) * stride + x * 4];
+        EXPECT_EQ(out[0], in[2]);
+        EXPECT_EQ(out[1], in[1]);
+        EXPECT_EQ(out[2], in[0]);
+        EXPECT_EQ(out[3], 255);
+      }
+  }
 }

@@ -5,7 +5,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
 #include <chrono>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -66,5 +69,16 @@ class TestGame {
   bool exited_ = false;
   int status_ = -1;
 };
+
+// A view's pixel near its bottom edge, below the test game's bars and far from its stamp band, is
+// the game's background (0.16, 0.18, 0.24): red, green and blue where they belong, whatever byte
+// order the game's pixels were read in. `view`: 8-bit RGBA, top row first.
+inline void expect_game_background_below_the_bars(const std::vector<std::uint8_t>& view, int width, int height) {
+  const std::size_t at = (static_cast<std::size_t>(height - 2) * width + static_cast<std::size_t>(width / 2)) * 4;
+  ASSERT_LT(at + 3, view.size());
+  EXPECT_NEAR(view[at + 0], 41, 2);
+  EXPECT_NEAR(view[at + 1], 46, 2);
+  EXPECT_NEAR(view[at + 2], 61, 2);
+}
 
 }  // namespace nelf::test

@@ -70,6 +70,8 @@ TEST_F(GlxStereoSourceTest, AQuadBufferGameGivesBothEyesFrameAfterFrame) {
       EXPECT_GT(f->captured_ns, 0);
       // Each eye is its own: the bars stand at opposite disparities, so the views differ.
       EXPECT_NE(f->left, f->right);
+      test::expect_game_background_below_the_bars(f->left, f->width, f->height);
+      test::expect_game_background_below_the_bars(f->right, f->width, f->height);
       // Both eyes carry the same frame's stamp, upright (a flipped view reads as no stamp).
       const auto left = read_frame_stamp(f->left.data(), f->width, f->height, f->bits);
       const auto right = read_frame_stamp(f->right.data(), f->width, f->height, f->bits);
@@ -205,6 +207,8 @@ TEST_F(GlxStereoSourceTest, AGameThatDrawsOnePictureGivesItsViewsAtEachSwap) {
       ASSERT_EQ(f->height, c.view_h);
       EXPECT_GT(f->captured_ns, 0);
       EXPECT_NE(f->left, f->right);  // the bars at opposite disparities
+      test::expect_game_background_below_the_bars(f->left, f->width, f->height);
+      test::expect_game_background_below_the_bars(f->right, f->width, f->height);
       const auto left = read_frame_stamp(f->left.data(), f->width, f->height, f->bits);
       const auto right = read_frame_stamp(f->right.data(), f->width, f->height, f->bits);
       ASSERT_TRUE(left && right) << "frame " << i;  // a flipped or misplaced view reads as no stamp
