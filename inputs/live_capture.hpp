@@ -11,13 +11,16 @@
 #include <vector>
 
 #include "inputs/source.hpp"
+#include "inputs/view_bytes.hpp"
 
 namespace nelf {
 
-// One read of the picture: tightly packed RGBA, row 0 the top, alpha 255.
+// One read of the picture: tightly packed 8-bit pixels in `order` (an X server's BGRX as it keeps
+// them, or RGBA), row 0 the top, alpha 255 or unset.
 struct CapturedImage {
   int width = 0, height = 0;
-  std::vector<std::uint8_t> rgba;
+  std::vector<std::uint8_t> pixels;
+  ByteOrder order = ByteOrder::rgba;
   std::chrono::steady_clock::time_point captured_at;  // when the read finished (CLOCK_MONOTONIC)
 };
 

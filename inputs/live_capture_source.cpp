@@ -23,8 +23,8 @@ namespace {
 std::vector<std::uint8_t> view_of(const CapturedImage& image, const PixelRect& rect, std::array<int, 2> block) {
   const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(image.width) * 4;
   return rgba8_block_means(
-      &image.rgba[static_cast<std::size_t>(rect.y) * stride + static_cast<std::size_t>(rect.x) * 4], stride, rect.width,
-      rect.height, block);
+      &image.pixels[static_cast<std::size_t>(rect.y) * stride + static_cast<std::size_t>(rect.x) * 4], stride,
+      rect.width, rect.height, block, image.order);
 }
 
 class LiveCaptureSource final : public Source {
@@ -89,23 +89,26 @@ class LiveCaptureSource final : public Source {
 
  private:
   CapturedImage scaled(const CapturedImage& image) {
-    if (!scaler_ || scaled_from_ != std::pair(image.width, image.height)) {
+    if (!scaler_ || scaled_from_ != std::pair(image.width, image.height) || scaled_order_ != image.order) {
       if (!scaler_)
         fmt::print(stderr, "nelf: {}: the picture is now {}x{}; scaled to {}x{}, the size it started at\n",
                    printable(input_), image.width, image.height, width_, height_);
-      scaler_.reset(sws_getContext(image.width, image.height, AV_PIX_FMT_RGBA, width_, height_, AV_PIX_FMT_RGBA,
-                                   SWS_BILINEAR, nullptr, nullptr, nullptr));
+      const AVPixelFormat format = image.order == ByteOrder::bgrx ? AV_PIX_FMT_BGR0 : AV_PIX_FMT_RGBA;
+      scaler_.reset(sws_getContext(image.width, image.height, format, width_, height_, format, SWS_BILINEAR, nullptr,
+                                   nullptr, nullptr));
       if (!scaler_) throw UserError(fmt::format("{}: cannot scale the resized window", printable(input_)), 1);
       scaled_from_ = {image.width, image.height};
+      scaled_order_ = image.order;
     }
     CapturedImage out;
     out.width = width_;
     out.height = height_;
     out.captured_at = image.captured_at;
-    out.rgba.resize(static_cast<std::size_t>(width_) * height_ * 4);
-    const std::uint8_t* src[1] = {image.rgba.data()};
+    out.order = image.order;
+    out.pixels.resize(static_cast<std::size_t>(width_) * height_ * 4);
+    const std::uint8_t* src[1] = {image.pixels.data()};
     const int src_stride[1] = {image.width * 4};
-    std::uint8_t* dst[1] = {out.rgba.data()};
+    std::uint8_t* dst[1] = {out.pixels.data()};
     const int dst_stride[1] = {width_ * 4};
     sws_scale(scaler_.get(), src, src_stride, 0, image.height, dst, dst_stride);
     return out;
@@ -124,6 +127,7 @@ class LiveCaptureSource final : public Source {
   std::array<int, 2> block_{1, 1};  // what negotiate() set
   ffmpeg::SwsContextPtr scaler_;
   std::pair<int, int> scaled_from_{0, 0};
+  ByteOrder scaled_order_ = ByteOrder::rgba;
 };
 
 }  // namespace

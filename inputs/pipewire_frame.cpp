@@ -118,11 +118,11 @@ std::optional<CapturedImage> PipeWireFrameReader::copy_rgb(const spa_data& d) co
   CapturedImage image;
   image.width = width_;
   image.height = height_;
-  image.rgba.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
+  image.pixels.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
   const auto* base = static_cast<const std::uint8_t*>(d.data) + offset;
   for (int y = 0; y < height_; ++y) {
     const std::uint8_t* src = base + static_cast<std::size_t>(y) * stride;
-    std::uint8_t* dst = image.rgba.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) * 4;
+    std::uint8_t* dst = image.pixels.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) * 4;
     for (int x = 0; x < width_; ++x, src += o.bytes, dst += 4) {
       dst[0] = src[o.r];
       dst[1] = src[o.g];
@@ -183,8 +183,8 @@ std::optional<CapturedImage> PipeWireFrameReader::convert_yuv(const spa_buffer& 
   CapturedImage image;
   image.width = width_;
   image.height = height_;
-  image.rgba.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
-  std::uint8_t* out[4] = {image.rgba.data(), nullptr, nullptr, nullptr};
+  image.pixels.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
+  std::uint8_t* out[4] = {image.pixels.data(), nullptr, nullptr, nullptr};
   const int out_strides[4] = {width_ * 4, 0, 0, 0};
   if (sws_scale(yuv_to_rgba_.get(), data, strides, 0, height_, out, out_strides) != height_) return std::nullopt;
   return image;

@@ -102,7 +102,7 @@ TEST(PipeWireFrameReader, PlanarYuvInAPlaneADataOrAllInOneIsWhatFfmpegMakesOfIt)
     PipeWireFrameReader reader(format_of(SPA_VIDEO_FORMAT_I420));
     const auto image = reader.read(f.finish());
     ASSERT_TRUE(image);
-    EXPECT_EQ(image->rgba, expected);
+    EXPECT_EQ(image->pixels, expected);
   }
   {
     SCOPED_TRACE("every plane in one spa_data, rows of 96 bytes");
@@ -115,7 +115,7 @@ TEST(PipeWireFrameReader, PlanarYuvInAPlaneADataOrAllInOneIsWhatFfmpegMakesOfIt)
     PipeWireFrameReader reader(format_of(SPA_VIDEO_FORMAT_I420));
     const auto image = reader.read(f.finish());
     ASSERT_TRUE(image);
-    EXPECT_EQ(image->rgba, expected);
+    EXPECT_EQ(image->pixels, expected);
   }
   {
     SCOPED_TRACE("YV12: V before U");
@@ -126,7 +126,7 @@ TEST(PipeWireFrameReader, PlanarYuvInAPlaneADataOrAllInOneIsWhatFfmpegMakesOfIt)
     PipeWireFrameReader reader(format_of(SPA_VIDEO_FORMAT_YV12));
     const auto image = reader.read(f.finish());
     ASSERT_TRUE(image);
-    EXPECT_EQ(image->rgba, expected);
+    EXPECT_EQ(image->pixels, expected);
   }
 }
 
@@ -148,7 +148,7 @@ TEST(PipeWireFrameReader, SemiPlanarAndPackedYuvAreWhatFfmpegMakesOfThem) {
     PipeWireFrameReader reader(format_of(SPA_VIDEO_FORMAT_NV12));
     const auto image = reader.read(f.finish());
     ASSERT_TRUE(image);
-    EXPECT_EQ(image->rgba, ffmpeg_rgba(nv12, "nv12"));
+    EXPECT_EQ(image->pixels, ffmpeg_rgba(nv12, "nv12"));
   }
   {
     SCOPED_TRACE("YUY2, rows padded to 160 bytes");
@@ -157,7 +157,7 @@ TEST(PipeWireFrameReader, SemiPlanarAndPackedYuvAreWhatFfmpegMakesOfThem) {
     PipeWireFrameReader reader(format_of(SPA_VIDEO_FORMAT_YUY2));
     const auto image = reader.read(f.finish());
     ASSERT_TRUE(image);
-    EXPECT_EQ(image->rgba, ffmpeg_rgba(yuy2, "yuyv422"));
+    EXPECT_EQ(image->pixels, ffmpeg_rgba(yuy2, "yuyv422"));
   }
 }
 
@@ -172,10 +172,10 @@ TEST(PipeWireFrameReader, RgbOrdersAreCopiedWithTheirStride) {
   ASSERT_TRUE(image);
   for (int i = 0; i < kWidth * kHeight; ++i) {
     const auto p = static_cast<std::size_t>(i) * 4;
-    ASSERT_EQ(image->rgba[p + 0], 200);
-    ASSERT_EQ(image->rgba[p + 1], bgrx[p + 1]);
-    ASSERT_EQ(image->rgba[p + 2], bgrx[p + 0]);
-    ASSERT_EQ(image->rgba[p + 3], 255);
+    ASSERT_EQ(image->pixels[p + 0], 200);
+    ASSERT_EQ(image->pixels[p + 1], bgrx[p + 1]);
+    ASSERT_EQ(image->pixels[p + 2], bgrx[p + 0]);
+    ASSERT_EQ(image->pixels[p + 3], 255);
   }
 }
 

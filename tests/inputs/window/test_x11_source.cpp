@@ -104,6 +104,8 @@ TEST_F(X11SourceTest, EachLayoutTheGameDrawsGivesItsTwoViewsFrameAfterFrame) {
       if (!stamps) continue;  // the window's first contents, before the game's first frame
       ++stamped;
       EXPECT_EQ(stamps->left, stamps->right) << "one game frame in both eyes";
+      test::expect_game_background_below_the_bars(frame->left, frame->width, frame->height);
+      test::expect_game_background_below_the_bars(frame->right, frame->width, frame->height);
       // A game frame may be read twice: the server draws a large frame in several requests, each
       // a change (the second read is of the whole frame); never an older one.
       if (last_frame) {
@@ -137,6 +139,7 @@ TEST_F(X11SourceTest, ViewsComeAsTheBlockMeansTheCompositorAsksFor) {
     if (left && right) {
       ++stamped;
       EXPECT_EQ(*left, *right);
+      test::expect_game_background_below_the_bars(f->left, 320, 120);
     }
   }
   EXPECT_GE(stamped, 6) << "the game's stamps read from the block means";
@@ -172,7 +175,10 @@ TEST_F(X11SourceTest, AResizedWindowIsScaledToItsFirstSize) {
     ASSERT_TRUE(frame);
     EXPECT_EQ(frame->width, 320);
     EXPECT_EQ(frame->height, 180);
-    if (i > 10 && stamps_of(*frame)) ++stamped_after;
+    if (i > 10 && stamps_of(*frame)) {
+      ++stamped_after;
+      test::expect_game_background_below_the_bars(frame->left, frame->width, frame->height);  // scaled
+    }
   }
   EXPECT_EQ(stamped_after, 5) << "the game's frames still read after the resize";
 }
