@@ -53,7 +53,8 @@ class StereoMatcher {
 };
 
 // Both views' disparity of a still (16-bit views, so its precision is kept), as `estimate` gives a
-// frame's; null when the views differ in size or cannot be matched.
+// frame's but without the cost budget (matched at max_working_width whatever the range); null when
+// the views differ in size or cannot be matched.
 std::shared_ptr<const StereoDisparity> estimate_still_disparity(const StereoPair& views);
 
 }  // namespace nelf
