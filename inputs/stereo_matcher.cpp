@@ -477,8 +477,8 @@ std::shared_ptr<const StereoDisparity> estimate_still_disparity(const StereoPair
   frame.right = view_bytes(r, 16);
   frame.aspect = views.left.aspect();
   // A still is matched once, at the largest working width whatever its disparity range: the cost
-  // budget is what keeps a video frame within its time (a plane close to the eye matched at 256
-  // pixels wide rather than 480 cost its retina 0.7 dB on ii-2160-testbed, docs/depth.md).
+  // budget is what keeps a video frame within its time, and a plane close to the eye matched
+  // coarser costs the retina most of a decibel on the finer displays (docs/depth.md).
   StereoMatcherSettings settings;
   settings.cost_budget = std::numeric_limits<double>::infinity();
   return StereoMatcher(settings).estimate(frame);

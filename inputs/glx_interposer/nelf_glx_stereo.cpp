@@ -254,8 +254,8 @@ void send_eyes(Eyes& e, std::int64_t swapped_ns) {
 // The window's picture into the next shared slot (where a left eye goes), rows bottom-up, read
 // from the back buffer the swap is about to show. Read as BGRA, the order the window's pixels are
 // kept in (X visuals): Mesa's software OpenGL then copies the rows, where RGBA took it a pass that
-// swaps every pixel's bytes (2560x720: 0.9 ms against 3.3 ms, time the frame waits to be shown).
-// nelf reorders the block means it makes of them.
+// swaps every pixel's bytes, time the frame waits to be shown (docs/PERFORMANCE.md). nelf reorders
+// the block means it makes of them.
 void send_picture(Picture& p, std::int64_t swapped_ns) {
   NELF_REAL_GL(glGetIntegerv);
   NELF_REAL_GL(glBindFramebuffer);
