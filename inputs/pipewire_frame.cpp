@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <utility>
 
 extern "C" {
@@ -120,6 +121,15 @@ std::optional<CapturedImage> PipeWireFrameReader::copy_rgb(const spa_data& d) co
   image.height = height_;
   image.pixels.resize(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
   const auto* base = static_cast<const std::uint8_t*>(d.data) + offset;
+  if (o.bytes == 4 && o.r == 2 && o.g == 1 && o.b == 0) {
+    // BGRx and BGRA, what desktops' screencasts send: kept in their order, a copy of each row (the
+    // block means reorder a quarter of the bytes or fewer), as the X11 capture keeps its server's.
+    image.order = ByteOrder::bgrx;
+    for (int y = 0; y < height_; ++y)
+      std::memcpy(image.pixels.data() + static_cast<std::size_t>(y) * row, base + static_cast<std::size_t>(y) * stride,
+                  row);
+    return image;
+  }
   for (int y = 0; y < height_; ++y) {
     const std::uint8_t* src = base + static_cast<std::size_t>(y) * stride;
     std::uint8_t* dst = image.pixels.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) * 4;

@@ -1,8 +1,9 @@
 #pragma once
 // One frame of a PipeWire video node, as the `pipewire:` source reads it (inputs/pipewire_capture):
-// a buffer in shared memory in one of the formats below, turned into tightly packed RGBA. 8-bit
-// RGB in any byte order is copied; 8-bit YUV (what cameras, capture cards' nodes and encoders send)
-// goes through swscale, with the node's matrix and range.
+// a buffer in shared memory in one of the formats below, turned into tightly packed 8-bit pixels:
+// BGRx and BGRA copied as they are (ByteOrder::bgrx), 8-bit RGB in any other byte order reordered
+// into RGBA; 8-bit YUV (what cameras, capture cards' nodes and encoders send) goes through swscale
+// into RGBA, with the node's matrix and range.
 #include <optional>
 #include <string>
 #include <vector>

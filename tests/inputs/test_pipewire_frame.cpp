@@ -1,5 +1,6 @@
 // PipeWireFrameReader: the frames a PipeWire node sends in shared memory, in each layout a producer
-// may use, read as RGBA. The YUV reference is ffmpeg's own conversion of the same raw frame.
+// may use, read as RGBA (BGRx kept in its order). The YUV reference is ffmpeg's own conversion of
+// the same raw frame.
 #include "inputs/pipewire_frame.hpp"
 
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "inputs/view_bytes.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace nelf {
@@ -162,20 +164,46 @@ TEST(PipeWireFrameReader, SemiPlanarAndPackedYuvAreWhatFfmpegMakesOfThem) {
 }
 
 TEST(PipeWireFrameReader, RgbOrdersAreCopiedWithTheirStride) {
-  std::vector<std::uint8_t> bgrx;
-  for (int i = 0; i < kWidth * kHeight; ++i)
-    bgrx.insert(bgrx.end(), {static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i / 7), 200, 0});
-  Frame f;
-  f.add(padded(bgrx, kWidth * 4, kHeight, kWidth * 4 + 12, 4), 4, kWidth * 4 + 12);
-  PipeWireFrameReader reader(format_of(SPA_VIDEO_FORMAT_BGRx));
-  const auto image = reader.read(f.finish());
-  ASSERT_TRUE(image);
+  std::vector<std::uint8_t> bgrx, xbgr;
   for (int i = 0; i < kWidth * kHeight; ++i) {
-    const auto p = static_cast<std::size_t>(i) * 4;
-    ASSERT_EQ(image->pixels[p + 0], 200);
-    ASSERT_EQ(image->pixels[p + 1], bgrx[p + 1]);
-    ASSERT_EQ(image->pixels[p + 2], bgrx[p + 0]);
-    ASSERT_EQ(image->pixels[p + 3], 255);
+    const auto b = static_cast<std::uint8_t>(i), g = static_cast<std::uint8_t>(i / 7);
+    bgrx.insert(bgrx.end(), {b, g, 200, 0});
+    xbgr.insert(xbgr.end(), {0, b, g, 200});
+  }
+  {
+    SCOPED_TRACE("BGRx: kept in its order, rows padded, the chunk 4 bytes in");
+    Frame f;
+    f.add(padded(bgrx, kWidth * 4, kHeight, kWidth * 4 + 12, 4), 4, kWidth * 4 + 12);
+    PipeWireFrameReader reader(format_of(SPA_VIDEO_FORMAT_BGRx));
+    const auto image = reader.read(f.finish());
+    ASSERT_TRUE(image);
+    EXPECT_EQ(image->order, ByteOrder::bgrx);
+    EXPECT_EQ(image->pixels, bgrx);
+    // What the compositor is given of it: RGBA, alpha 255.
+    const auto means = rgba8_block_means(image->pixels.data(), kWidth * 4, kWidth, kHeight, {1, 1}, image->order);
+    for (int i = 0; i < kWidth * kHeight; ++i) {
+      const auto p = static_cast<std::size_t>(i) * 4;
+      ASSERT_EQ(means[p + 0], 200);
+      ASSERT_EQ(means[p + 1], bgrx[p + 1]);
+      ASSERT_EQ(means[p + 2], bgrx[p + 0]);
+      ASSERT_EQ(means[p + 3], 255);
+    }
+  }
+  {
+    SCOPED_TRACE("xBGR: reordered into RGBA");
+    Frame f;
+    f.add(padded(xbgr, kWidth * 4, kHeight, kWidth * 4 + 8, 0), 0, kWidth * 4 + 8);
+    PipeWireFrameReader reader(format_of(SPA_VIDEO_FORMAT_xBGR));
+    const auto image = reader.read(f.finish());
+    ASSERT_TRUE(image);
+    EXPECT_EQ(image->order, ByteOrder::rgba);
+    for (int i = 0; i < kWidth * kHeight; ++i) {
+      const auto p = static_cast<std::size_t>(i) * 4;
+      ASSERT_EQ(image->pixels[p + 0], 200);
+      ASSERT_EQ(image->pixels[p + 1], bgrx[p + 1]);
+      ASSERT_EQ(image->pixels[p + 2], bgrx[p + 0]);
+      ASSERT_EQ(image->pixels[p + 3], 255);
+    }
   }
 }
 
