@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -163,48 +164,35 @@ TEST(PipeWireFrameReader, SemiPlanarAndPackedYuvAreWhatFfmpegMakesOfThem) {
   }
 }
 
+// A one-plane RGB frame of `format` read: `packed`'s rows `stride` bytes apart, the chunk `offset`
+// bytes in.
+std::optional<CapturedImage> read_rgb(spa_video_format format, const std::vector<std::uint8_t>& packed, int stride,
+                                      int offset) {
+  Frame f;
+  f.add(padded(packed, kWidth * 4, kHeight, stride, offset), static_cast<std::uint32_t>(offset), stride);
+  PipeWireFrameReader reader(format_of(format));
+  return reader.read(f.finish());
+}
+
 TEST(PipeWireFrameReader, RgbOrdersAreCopiedWithTheirStride) {
-  std::vector<std::uint8_t> bgrx, xbgr;
+  std::vector<std::uint8_t> bgrx, xbgr, rgba;
   for (int i = 0; i < kWidth * kHeight; ++i) {
     const auto b = static_cast<std::uint8_t>(i), g = static_cast<std::uint8_t>(i / 7);
     bgrx.insert(bgrx.end(), {b, g, 200, 0});
     xbgr.insert(xbgr.end(), {0, b, g, 200});
+    rgba.insert(rgba.end(), {200, g, b, 255});
   }
-  {
-    SCOPED_TRACE("BGRx: kept in its order, rows padded, the chunk 4 bytes in");
-    Frame f;
-    f.add(padded(bgrx, kWidth * 4, kHeight, kWidth * 4 + 12, 4), 4, kWidth * 4 + 12);
-    PipeWireFrameReader reader(format_of(SPA_VIDEO_FORMAT_BGRx));
-    const auto image = reader.read(f.finish());
-    ASSERT_TRUE(image);
-    EXPECT_EQ(image->order, ByteOrder::bgrx);
-    EXPECT_EQ(image->pixels, bgrx);
-    // What the compositor is given of it: RGBA, alpha 255.
-    const auto means = rgba8_block_means(image->pixels.data(), kWidth * 4, kWidth, kHeight, {1, 1}, image->order);
-    for (int i = 0; i < kWidth * kHeight; ++i) {
-      const auto p = static_cast<std::size_t>(i) * 4;
-      ASSERT_EQ(means[p + 0], 200);
-      ASSERT_EQ(means[p + 1], bgrx[p + 1]);
-      ASSERT_EQ(means[p + 2], bgrx[p + 0]);
-      ASSERT_EQ(means[p + 3], 255);
-    }
-  }
-  {
-    SCOPED_TRACE("xBGR: reordered into RGBA");
-    Frame f;
-    f.add(padded(xbgr, kWidth * 4, kHeight, kWidth * 4 + 8, 0), 0, kWidth * 4 + 8);
-    PipeWireFrameReader reader(format_of(SPA_VIDEO_FORMAT_xBGR));
-    const auto image = reader.read(f.finish());
-    ASSERT_TRUE(image);
-    EXPECT_EQ(image->order, ByteOrder::rgba);
-    for (int i = 0; i < kWidth * kHeight; ++i) {
-      const auto p = static_cast<std::size_t>(i) * 4;
-      ASSERT_EQ(image->pixels[p + 0], 200);
-      ASSERT_EQ(image->pixels[p + 1], bgrx[p + 1]);
-      ASSERT_EQ(image->pixels[p + 2], bgrx[p + 0]);
-      ASSERT_EQ(image->pixels[p + 3], 255);
-    }
-  }
+  // BGRx: kept in its order; what the compositor is given of it is RGBA, alpha 255.
+  const auto kept = read_rgb(SPA_VIDEO_FORMAT_BGRx, bgrx, kWidth * 4 + 12, 4);
+  ASSERT_TRUE(kept);
+  EXPECT_EQ(kept->order, ByteOrder::bgrx);
+  EXPECT_EQ(kept->pixels, bgrx);
+  EXPECT_EQ(rgba8_block_means(kept->pixels.data(), kWidth * 4, kWidth, kHeight, {1, 1}, kept->order), rgba);
+  // xBGR: reordered into RGBA.
+  const auto reordered = read_rgb(SPA_VIDEO_FORMAT_xBGR, xbgr, kWidth * 4 + 8, 0);
+  ASSERT_TRUE(reordered);
+  EXPECT_EQ(reordered->order, ByteOrder::rgba);
+  EXPECT_EQ(reordered->pixels, rgba);
 }
 
 TEST(PipeWireFrameReader, ABufferShortOfItsFormatOrMarkedCorruptedIsNoFrame) {
