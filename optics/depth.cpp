@@ -63,6 +63,23 @@ DisparitySurface::DisparitySurface(const ViewDisparity& disparity)
   const auto [lo, hi] = std::minmax_element(values_.begin(), values_.end());
   back_ = *lo;
   front_ = *hi;
+  // Each tile's largest value, then the largest of its 3 × 3 tiles.
+  constexpr int tile = depth_bound_tile;
+  bound_width_ = (width_ + tile - 1) / tile;
+  bound_height_ = (height_ + tile - 1) / tile;
+  const auto at_tile = [&](int tx, int ty) { return static_cast<std::size_t>(ty) * bound_width_ + tx; };
+  std::vector<float> tile_front(static_cast<std::size_t>(bound_width_) * bound_height_, back_);
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) {
+      float& m = tile_front[at_tile(x / tile, y / tile)];
+      m = std::max(m, values_[static_cast<std::size_t>(y) * width_ + x]);
+    }
+  bounds_.assign(tile_front.size(), back_);
+  for (int ty = 0; ty < bound_height_; ++ty)
+    for (int tx = 0; tx < bound_width_; ++tx)
+      for (int ny = std::max(ty - 1, 0); ny <= std::min(ty + 1, bound_height_ - 1); ++ny)
+        for (int nx = std::max(tx - 1, 0); nx <= std::min(tx + 1, bound_width_ - 1); ++nx)
+          bounds_[at_tile(tx, ty)] = std::max(bounds_[at_tile(tx, ty)], tile_front[at_tile(nx, ny)]);
 }
 
 float DisparitySurface::at(Vec2 uv) const {
@@ -79,8 +96,19 @@ Vec2 DisparitySurface::hit(Vec2 flat_uv, Vec2 gain) const {
   // texel coordinate at the front, v how many texels it moves per unit of t along each axis.
   const double range = front - back;
   const Vec2 at_front = along(front);
-  const double p[2] = {at_front.x * width_, at_front.y * height_};
+  const double start[2] = {at_front.x * width_, at_front.y * height_};
   const double v[2] = {-gain.x * width_, -gain.y * height_};
+  // The skip: until the ray falls to its tile's bound, or has moved depth_bound_tile − 1 texels
+  // along an axis (a texel index moves by at most as much: the bound still holds), it is in front
+  // of every texel it crosses. Out of the map its texels are the edge's (clamped), no farther away.
+  const int size[2] = {width_, height_};
+  int tile[2];
+  for (int a = 0; a < 2; ++a)
+    tile[a] = std::clamp(static_cast<int>(std::floor(start[a])), 0, size[a] - 1) / depth_bound_tile;
+  const double bound = bounds_[static_cast<std::size_t>(tile[1]) * bound_width_ + tile[0]];
+  const double fastest = std::max({std::abs(v[0]), std::abs(v[1]), 1e-30});
+  double t = std::min({front - bound, (depth_bound_tile - 1) / fastest, range});
+  const double p[2] = {start[0] + v[0] * t, start[1] + v[1] * t};
   int texel[2], step[2];
   double delta[2], next[2];
   for (int a = 0; a < 2; ++a) {
@@ -88,9 +116,8 @@ Vec2 DisparitySurface::hit(Vec2 flat_uv, Vec2 gain) const {
     step[a] = v[a] > 0.0 ? 1 : v[a] < 0.0 ? -1 : 0;
     const double speed = std::max(std::abs(v[a]), 1e-30);
     delta[a] = 1.0 / speed;
-    next[a] = (v[a] > 0.0 ? std::floor(p[a]) + 1.0 - p[a] : p[a] - std::floor(p[a])) / speed;
+    next[a] = t + (v[a] > 0.0 ? std::floor(p[a]) + 1.0 - p[a] : p[a] - std::floor(p[a])) / speed;
   }
-  double t = 0.0;
   for (int i = 0; i < depth_search_texels; ++i) {
     const double t_next = std::min({next[0], next[1], range});
     const double value = values_[static_cast<std::size_t>(std::clamp(texel[1], 0, height_ - 1)) * width_ +

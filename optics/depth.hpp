@@ -58,17 +58,28 @@ class DisparitySurface {
   // The value at screen coordinate uv (u right, t down, in [0, 1]; clamped to the map), nearest texel.
   float at(Vec2 uv) const;
 
+  // Per tile of depth_bound_tile × depth_bound_tile texels (row-major, bound_width() × bound_height()),
+  // the largest value of the tile and its eight neighbours: no texel within depth_bound_tile − 1
+  // texels of one in the tile (per axis) is nearer.
+  const std::vector<float>& front_bounds() const { return bounds_; }
+  int bound_width() const { return bound_width_; }
+  int bound_height() const { return bound_height_; }
+
   // Where on the screen (uv) a ray shows the surface: the ray meets the flat screen at `flat_uv` and
   // shifts by `gain` (uv) per unit of δ / W (pupil_gain of its pupil-plane crossing). The front-most
   // crossing, exact for the nearest-texel surface: the ray walks the texels it crosses from the front
   // of the range to its back; in a texel of value v that it enters at δ / W = a and leaves at b < a
-  // it is at or behind the surface from v down, so it crosses at min(v, a) when v ≥ b. A surface of
+  // it is at or behind the surface from v down, so it crosses at min(v, a) when v ≥ b. The walk
+  // starts where the ray falls to the front bound of the tile it starts in, or leaves the texels that
+  // bound holds for, whichever comes first: nothing before is near enough to cross it. A surface of
   // one value v gives flat_uv + gain · v exactly (0: flat_uv).
   Vec2 hit(Vec2 flat_uv, Vec2 gain) const;
 
  private:
   int width_ = 0, height_ = 0;
   std::vector<float> values_;
+  int bound_width_ = 0, bound_height_ = 0;
+  std::vector<float> bounds_;
   float front_ = 0.f, back_ = 0.f;
   bool unknown_ = false;
 };
@@ -77,6 +88,10 @@ class DisparitySurface {
 // over e times the frame's disparity range, a few texels of the map; past this many it is taken to
 // show the back of the range.
 inline constexpr int depth_search_texels = 48;
+// The side of a tile of the surface's front bounds, in texels (the shader's too): with a tile's
+// bound a ray in front of a far region skips to it and crosses a texel or two, rather than walking
+// down from the front of the whole frame's range (docs/PERFORMANCE.md).
+inline constexpr int depth_bound_tile = 8;
 
 // The uv shift per unit of δ / W of a ray crossing the pupil plane at `pupil_mm`: (p_x / e, −p_y W / (e H)).
 Vec2 pupil_gain(const DepthGeometry& g, Vec2 pupil_mm);

@@ -308,6 +308,8 @@ void GlCompositor::render(Eye eye, const GlTextureView& view, std::array<int, 2>
     }
     glBindSampler(shaders::disparity_unit, 0);
     glBindTextureUnit(shaders::disparity_unit, depth_[e].texture.id());
+    glBindSampler(shaders::front_bound_unit, 0);
+    glBindTextureUnit(shaders::front_bound_unit, depth_[e].bounds.id());
   }
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   glViewport(target.x, target.y, m.panel[0], m.panel[1]);
@@ -417,11 +419,14 @@ void GlCompositor::set_depth(Eye eye, std::shared_ptr<const DisparitySurface> su
   context_->make_current();
   if (!d.texture || d.width != d.surface->width() || d.height != d.surface->height()) {
     d.texture = gl::make_texture_2d(GL_R32F, d.surface->width(), d.surface->height());
+    d.bounds = gl::make_texture_2d(GL_R32F, d.surface->bound_width(), d.surface->bound_height());
     d.width = d.surface->width();
     d.height = d.surface->height();
   }
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTextureSubImage2D(d.texture.id(), 0, 0, 0, d.width, d.height, GL_RED, GL_FLOAT, d.surface->values().data());
+  glTextureSubImage2D(d.bounds.id(), 0, 0, 0, d.surface->bound_width(), d.surface->bound_height(), GL_RED, GL_FLOAT,
+                      d.surface->front_bounds().data());
   gl::check_error("uploading the disparity");
 }
 

@@ -153,6 +153,7 @@ class GlCompositor final : public Compositor {
   struct DepthSurface {
     std::shared_ptr<const DisparitySurface> surface;
     gl::Texture texture;  // R32F, the surface's values
+    gl::Texture bounds;   // R32F, its front bounds (DisparitySurface::front_bounds)
     int width = 0, height = 0;
   };
 

@@ -14,6 +14,7 @@ inline constexpr unsigned view_unit = 0;              // u_view (u_input in pref
 inline constexpr unsigned second_unit = 1;            // u_map (elemental_lookup.frag), u_label (text_overlay.frag)
 inline constexpr unsigned disparity_unit = 2;         // u_disparity (elemental.frag, NELF_DEPTH)
 inline constexpr unsigned hits_unit = 3;              // u_hits (elemental.frag, NELF_DEPTH_HITS)
+inline constexpr unsigned front_bound_unit = 4;       // u_front_bound (depth_search.glsl)
 inline constexpr unsigned hits_image_unit = 0;        // image u_hits (elemental_depth_lookup.frag)
 
 // Uniform locations: `layout(location = N)`, per shader.

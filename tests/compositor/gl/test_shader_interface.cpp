@@ -119,8 +119,10 @@ TEST(ShaderInterface, UniformLocationsAndTextureUnitsAreTheDeclaredOnes) {
     EXPECT_EQ(glGetUniformLocation(depth.id(), "u_pupil_per_lens"), at::depth::pupil_per_lens);
     EXPECT_EQ(sampler_unit(depth.id(), "u_view"), static_cast<GLint>(shaders::view_unit));
     EXPECT_EQ(sampler_unit(depth.id(), "u_disparity"), static_cast<GLint>(shaders::disparity_unit));
+    EXPECT_EQ(sampler_unit(depth.id(), "u_front_bound"), static_cast<GLint>(shaders::front_bound_unit));
   }
   const gl::Program lookup_depth = link(ProgramKind::depth_lookup);
+  EXPECT_EQ(sampler_unit(lookup_depth.id(), "u_front_bound"), static_cast<GLint>(shaders::front_bound_unit));
   EXPECT_EQ(sampler_unit(lookup_depth.id(), "u_map"), static_cast<GLint>(shaders::second_unit));
   EXPECT_EQ(sampler_unit(lookup_depth.id(), "u_hits"), static_cast<GLint>(shaders::hits_image_unit));
   const gl::Program strips_from_hits = link(ProgramKind::depth_border_hits);
