@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <utility>
 
 extern "C" {
@@ -125,9 +124,8 @@ std::optional<CapturedImage> PipeWireFrameReader::copy_rgb(const spa_data& d) co
     // BGRx and BGRA, what desktops' screencasts send: kept in their order, a copy of each row (the
     // block means reorder a quarter of the bytes or fewer), as the X11 capture keeps its server's.
     image.order = ByteOrder::bgrx;
-    for (int y = 0; y < height_; ++y)
-      std::memcpy(image.pixels.data() + static_cast<std::size_t>(y) * row, base + static_cast<std::size_t>(y) * stride,
-                  row);
+    av_image_copy_plane(image.pixels.data(), static_cast<int>(row), base, static_cast<int>(stride),
+                        static_cast<int>(row), height_);
     return image;
   }
   for (int y = 0; y < height_; ++y) {

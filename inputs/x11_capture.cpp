@@ -21,6 +21,10 @@
 #include <mutex>
 #include <thread>
 
+extern "C" {
+#include <libavutil/imgutils.h>
+}
+
 #include "core/printable.hpp"
 #include "core/user_error.hpp"
 
@@ -346,12 +350,10 @@ struct X11Capture::State {
     out.width = im.width;
     out.height = im.height;
     out.order = ByteOrder::bgrx;
-    const std::size_t row = static_cast<std::size_t>(im.width) * 4;
-    out.pixels.resize(row * im.height);
-    for (int y = 0; y < im.height; ++y)
-      std::memcpy(out.pixels.data() + static_cast<std::size_t>(y) * row,
-                  reinterpret_cast<const std::uint8_t*>(im.data) + static_cast<std::size_t>(y) * im.bytes_per_line,
-                  row);
+    const int row = im.width * 4;
+    out.pixels.resize(static_cast<std::size_t>(row) * im.height);
+    av_image_copy_plane(out.pixels.data(), row, reinterpret_cast<const std::uint8_t*>(im.data), im.bytes_per_line, row,
+                        im.height);
     return out;
   }
 };

@@ -13,16 +13,17 @@ const int depth_bound_tile = 8;                      // optics/depth.hpp: depth_
 // gain per unit of δ / W) with the surface: the ray walks the map's texels from the front of the
 // range to its back; in a texel of value v that it enters at δ / W = a and leaves at b < a, it is at
 // or behind the surface from v down, so it crosses there (at min(v, a)) when v >= b. One fetch a
-// texel crossed; steps of half a texel and a bisection of the crossing one took three times as many. The
-// walk starts where the ray falls to the front bound of the tile it starts in, or has moved
-// depth_bound_tile − 1 texels along an axis (past that the bound may not hold), whichever is first.
+// texel crossed; steps of half a texel and a bisection of the crossing one took three times as
+// many. The walk starts where the ray falls to the front bound of the tile it starts in, or has
+// moved depth_bound_tile − 1 texels along an axis (past that the bound may not hold), whichever is
+// first.
 float surface_hit(vec2 flat_uv, vec2 gain) {
   const float back = u_disparity_range.x, front = u_disparity_range.y;
   if (!(front > back)) return front;
   const ivec2 size = textureSize(u_disparity, 0);
   const float range = front - back;
   const vec2 start = (flat_uv + gain * front) * vec2(size);  // texel coordinate at the front
-  const vec2 v = -gain * vec2(size);                      // texels per unit of (front − δ / W)
+  const vec2 v = -gain * vec2(size);                          // texels per unit of (front − δ / W)
   const ivec2 tile = clamp(ivec2(floor(start)), ivec2(0), size - 1) / depth_bound_tile;
   const float bound = texelFetch(u_front_bound, tile, 0).r;
   const float fastest = max(max(abs(v.x), abs(v.y)), 1.0e-30);
