@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "hmz_output/frame_sink.hpp"
 #include "hmz_output/image_sink.hpp"
 #include "support/image_files.hpp"
 #include "support/test_support.hpp"
@@ -92,6 +93,16 @@ TEST(ImageSink, OverLargeJpegIsRefusedBeforeWriting) {
   const std::string e = write_error(Image(65536, 1), dir / "wide.jpg");
   EXPECT_NE(e.find("wide.jpg: 65536x1 exceeds JPEG's limit"), std::string::npos) << e;
   EXPECT_TRUE(files_in(dir.path()).empty());
+}
+
+// An output names an image sequence when its file name holds a printf conversion of the frame
+// number, as printf reads it: %d with an optional width; %% is a literal %.
+TEST(ImageSink, SequencePatternsAreAFrameNumbersConversion) {
+  for (const char* name : {"f_%d.png", "f_%03d.png", "%4d.tif", "take_%2d.exr", "100%%_%d.png"})
+    EXPECT_TRUE(is_image_sequence_pattern(name)) << name;
+  for (const char* name :
+       {"f.png", "100%.png", "a%b.png", "f_%0x.png", "f_%s.png", "frames_%d/one.png", "f_%", "x%%d.png"})
+    EXPECT_FALSE(is_image_sequence_pattern(name)) << name;
 }
 
 }  // namespace
