@@ -15,10 +15,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
-const std::string h264 = " -c:v libx264 -preset ultrafast -pix_fmt yuv420p";
-
 // A plain 2D 16:9 clip: red for 0.5 s, then blue for 0.5 s, at 10 fps.
 std::filesystem::path red_then_blue(const TempDir& dir) {
   return make_media(dir / "plain.mkv",

@@ -17,8 +17,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
 // The end of a command whose stdout or stderr was a pipe nobody reads any more.
 struct ClosedPipeResult {
   bool signalled = false;  // killed by a signal (`status` is then the signal number)

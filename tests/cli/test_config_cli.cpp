@@ -14,8 +14,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
 class ConfigCli : public ::testing::Test {
  protected:
   TempDir dir_;

@@ -12,8 +12,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
 constexpr std::size_t kPackedBytes = 1280u * 1470u * 4u;  // hmz-t1 on hdmi-fp-720p60
 
 TEST(ConvertRaw, WritesEveryPackedFrameAsRgbaOnStdoutAndSaysTheFormatOnStderr) {

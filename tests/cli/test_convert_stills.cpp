@@ -17,6 +17,7 @@ namespace {
 using test::expect_clean_failure;
 using test::files_in;
 using test::filled_image;
+using test::q;
 using test::read_back;
 using test::run_nelf;
 using test::shell_quote;
@@ -63,8 +64,6 @@ AreaStats stats(const test::ReadBack& img, int x0, int y0, int x1, int y1) {
 }
 
 std::filesystem::path small_profile(const TempDir& dir) { return test::write_small_profile(dir); }
-
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
 
 TEST(ConvertStills, HmzT1FramePackedPng) {
   TempDir dir;

@@ -15,8 +15,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
 nlohmann::json ffprobe_json(const std::filesystem::path& path, const std::string& what) {
   const CommandResult r = run_command("ffprobe -v error -of json " + what + " " + q(path));
   EXPECT_EQ(r.status, 0) << r.err;

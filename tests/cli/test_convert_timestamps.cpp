@@ -17,8 +17,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
 // What ffprobe says about one stream of a file: its codec and start_time, and its packets' first
 // pts, first dts and latest end (pts + duration).
 struct StreamTiming {

@@ -19,12 +19,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
-std::filesystem::path small_profile(const TempDir& dir) { return test::write_small_profile(dir); }
-
-const std::string h264 = " -c:v libx264 -preset ultrafast -pix_fmt yuv420p";
-
 // Frame `index` of a video decoded to packed RGB24.
 struct RgbFrame {
   int width = 0, height = 0;
@@ -123,7 +117,7 @@ Span packet_span(const std::filesystem::path& path, const std::string& stream, d
   }
   return span;
 }
-Probed probe(const std::filesystem::path& path) {
+Probed ffprobe_video(const std::filesystem::path& path) {
   Probed p;
   const auto r =
       run_command("ffprobe -v error -select_streams v:0 -show_entries stream=width,height -of csv=p=0 " + q(path));
@@ -149,11 +143,11 @@ std::string red_blue(int eye_w, int eye_h, bool stacked, int frames = 6, int rat
 TEST(ConvertVideo, HmzT1FramePackedOutput) {
   TempDir dir;
   make_media(dir / "clip.mkv", red_blue(320, 180, false, 3));
-  const auto r =
-      run_nelf("convert " + q(dir / "clip.mkv") + " " + q(dir / "out.mkv") + " --profile hmz-t1 --codec utvideo --quiet");
+  const auto r = run_nelf("convert " + q(dir / "clip.mkv") + " " + q(dir / "out.mkv") +
+                          " --profile hmz-t1 --codec utvideo --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err, "");
-  const Probed p = probe(dir / "out.mkv");
+  const Probed p = ffprobe_video(dir / "out.mkv");
   EXPECT_EQ(p.width, 1280);
   EXPECT_EQ(p.height, 1470);
   EXPECT_EQ(p.video_packets, 3);
@@ -221,7 +215,7 @@ TEST(ConvertVideo, SecondConversionUsesTheCachedTablesWithoutGl) {
 // Every layout sends the left (red) view to the top eye and the right (blue) one to the bottom eye.
 TEST(ConvertVideo, EveryLayoutRoutesTheEyes) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   make_media(dir / "wide.mkv", red_blue(320, 180, false));
   make_media(dir / "tall.mkv", red_blue(320, 180, true));
   make_media(dir / "packed.mkv",
@@ -275,7 +269,7 @@ TEST(ConvertVideo, EveryLayoutRoutesTheEyes) {
 
 TEST(ConvertVideo, OutputMatchesTheInputInFramesDurationAndAudio) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   // 12 frames at 24 fps (0.5 s) with 0.5 s of tone.
   make_media(dir / "clip.mkv",
              "-f lavfi -i color=c=red:s=320x180:r=24:d=0.5 -f lavfi -i color=c=blue:s=320x180:r=24:d=0.5 -f lavfi -i "
@@ -289,7 +283,7 @@ TEST(ConvertVideo, OutputMatchesTheInputInFramesDurationAndAudio) {
         run_nelf("convert " + q(dir / "clip.mkv") + " " + q(dir / name) + " --signal sbs --profile " + q(profile));
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find("wrote " + (dir / name).string()), std::string::npos) << r.err;
-    const Probed p = probe(dir / name);
+    const Probed p = ffprobe_video(dir / name);
     EXPECT_EQ(p.width, 320);
     EXPECT_EQ(p.height, 90);
     EXPECT_EQ(p.video_packets, 12);
@@ -302,7 +296,7 @@ TEST(ConvertVideo, OutputMatchesTheInputInFramesDurationAndAudio) {
                           " --no-audio --quiet --signal sbs --profile " + q(profile));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err, "");
-  const Probed p = probe(dir / "silent.mkv");
+  const Probed p = ffprobe_video(dir / "silent.mkv");
   EXPECT_EQ(p.video_packets, 12);
   EXPECT_FALSE(p.has_audio);
   EXPECT_EQ(files_in(dir.path()),
@@ -311,7 +305,7 @@ TEST(ConvertVideo, OutputMatchesTheInputInFramesDurationAndAudio) {
 
 TEST(ConvertVideo, FramesStartAndDurationTrim) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   // 1 s at 24 fps: both views red for the first half second, green after; a tone throughout.
   make_media(dir / "clip.mkv",
              "-f lavfi -i color=c=black:s=640x180:r=24:d=1 -f lavfi -i sine=frequency=440:sample_rate=48000:duration=1 "
@@ -321,7 +315,7 @@ TEST(ConvertVideo, FramesStartAndDurationTrim) {
 
   auto r = run_nelf("convert " + q(dir / "clip.mkv") + " " + q(dir / "five.mkv") + " --frames 5" + tail);
   ASSERT_EQ(r.status, 0) << r.err;
-  Probed p = probe(dir / "five.mkv");
+  Probed p = ffprobe_video(dir / "five.mkv");
   EXPECT_EQ(p.video_packets, 5);
   EXPECT_NEAR(p.video_end - p.video_start, 5.0 / 24, 0.5 / 24);
   EXPECT_NEAR(p.audio_end, p.video_end, 1.0 / 24);
@@ -329,7 +323,7 @@ TEST(ConvertVideo, FramesStartAndDurationTrim) {
 
   r = run_nelf("convert " + q(dir / "clip.mkv") + " " + q(dir / "late.mkv") + " --start 0.5 --duration 0.25" + tail);
   ASSERT_EQ(r.status, 0) << r.err;
-  p = probe(dir / "late.mkv");
+  p = ffprobe_video(dir / "late.mkv");
   EXPECT_EQ(p.video_packets, 6);
   EXPECT_NEAR(p.video_start, 0.0, 1.0 / 24);  // output time starts at 0
   EXPECT_NEAR(p.video_end - p.video_start, 0.25, 0.5 / 24);
@@ -352,11 +346,11 @@ TEST(ConvertVideo, FramesStartAndDurationTrim) {
 
 TEST(ConvertVideo, SyntheticClipWithAudio) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   const auto r = run_nelf("convert synthetic:duration=1,size=160x90 " + q(dir / "out.mkv") +
                           " --codec utvideo --quiet --profile " + q(profile));
   ASSERT_EQ(r.status, 0) << r.err;
-  const Probed p = probe(dir / "out.mkv");
+  const Probed p = ffprobe_video(dir / "out.mkv");
   EXPECT_EQ(p.width, 1280);
   EXPECT_EQ(p.height, 1470);
   EXPECT_EQ(p.video_packets, 24);
@@ -378,7 +372,7 @@ std::string packet_list(const std::filesystem::path& path, const std::string& st
 // streams with their tags, and the same packets.
 TEST(ConvertVideo, CarriesTheInputsAudioSubtitlesAndChaptersAsTheyAre) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   write_file(dir / "subs.srt", "1\n00:00:00,000 --> 00:00:00,400\nhello\n\n2\n00:00:00,500 --> 00:00:00,900\nbye\n");
   write_file(dir / "meta.txt", ";FFMETADATA1\ntitle=Clip\n[CHAPTER]\nTIMEBASE=1/1000\nSTART=0\nEND=500\ntitle=One\n");
   make_media(dir / "clip.mkv",
@@ -410,7 +404,7 @@ TEST(ConvertVideo, CarriesTheInputsAudioSubtitlesAndChaptersAsTheyAre) {
 
 TEST(ConvertVideo, BadInputs) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   const std::string tail = " " + q(dir / "out.mkv") + " --quiet --codec utvideo --profile " + q(profile);
   write_file(dir / "notes.mkv", "these are my notes, not a video\n");
   make_media(dir / "small.mkv", red_blue(320, 180, false));
@@ -433,7 +427,7 @@ TEST(ConvertVideo, BadInputs) {
 
 TEST(ConvertVideo, TruncatedInputWarnsOrFailsWithStrict) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   // Intra-only so that the frames before the cut decode; no audio to keep the cut in the video.
   make_media(dir / "whole.mkv", two_colour_input(320, 180, false, 12, 10) + " -c:v libx264 -preset ultrafast -g 1");
   const std::string bytes = read_file(dir / "whole.mkv");
@@ -448,7 +442,7 @@ TEST(ConvertVideo, TruncatedInputWarnsOrFailsWithStrict) {
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("nelf: warning: "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("lost or damaged"), std::string::npos) << r.err;
-  const Probed p = probe(dir / "out.mkv");
+  const Probed p = ffprobe_video(dir / "out.mkv");
   EXPECT_GE(p.video_packets, 3);
   EXPECT_LT(p.video_packets, 12);
   EXPECT_EQ(files_in(dir.path()), (std::vector<std::string>{"cut.mkv", "out.mkv", "small.toml"}));
@@ -456,7 +450,7 @@ TEST(ConvertVideo, TruncatedInputWarnsOrFailsWithStrict) {
 
 TEST(ConvertVideo, BadOutputsAndArguments) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   make_media(dir / "in.mkv", red_blue(320, 180, false, 3));
   write_file(dir / "taken.mkv", "precious");
   const std::string head = "convert " + q(dir / "in.mkv") + " ";
@@ -494,7 +488,7 @@ TEST(ConvertVideo, BadOutputsAndArguments) {
 // writes HEVC Main 10; other depths are one line.
 TEST(ConvertVideo, TenBitSourcesBecomeEightBitH264UnlessBits10) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   make_media(dir / "in.mkv", red_blue(320, 180, false, 6) +
                                  " -c:v libx265 -preset ultrafast -pix_fmt yuv420p10le -x265-params log-level=error");
   const auto stream = [&](const std::filesystem::path& file) {
@@ -536,7 +530,7 @@ TEST(ConvertVideo, TenBitSourcesBecomeEightBitH264UnlessBits10) {
 // name of an image sequence.
 TEST(ConvertVideo, OutputOntoAnInputIsRefused) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   make_media(dir / "in.mkv", red_blue(320, 180, false, 3));
   make_media(dir / "right.mkv", red_blue(160, 180, false, 3));
   std::filesystem::create_directory(dir / "sub");
@@ -577,7 +571,7 @@ TEST(ConvertVideo, OutputOntoAnInputIsRefused) {
 // replaced), as for stills; with -y the link itself is replaced, its target never created.
 TEST(ConvertVideo, DanglingSymlinkOutputNeedsOverwrite) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   make_media(dir / "in.mkv", red_blue(320, 180, false, 3));
   std::filesystem::create_symlink(dir / "missing.mkv", dir / "out.mkv");
   const std::string args =
@@ -595,7 +589,7 @@ TEST(ConvertVideo, DanglingSymlinkOutputNeedsOverwrite) {
 // being written (listed just before the signal) removed.
 TEST(ConvertVideo, InterruptLeavesNothing) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   const auto r =
       run_command(std::string(NELF_BINARY) + " convert synthetic:duration=30,size=320x180 " + q(dir / "out.mkv") +
                   " --profile " + q(profile) + " & pid=$!; sleep 2; ls -A " + q(dir.path()) +
@@ -613,7 +607,7 @@ TEST(ConvertVideo, InterruptLeavesNothing) {
 // sequence was being written.
 TEST(ConvertVideo, TerminateLeavesNothing) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   for (const std::string output : {"out.mkv", "frame_%04d.png"}) {
     SCOPED_TRACE(output);
     const auto r =
@@ -638,7 +632,7 @@ TEST(ConvertVideo, TerminateLeavesNothing) {
 // SIGQUIT, which a shell without job control ignores for background commands, went unheard).
 TEST(ConvertVideo, HangupAndQuitLeaveNothing) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   for (const std::string signal : {"HUP", "QUIT"})
     for (const std::string output : {"out.mkv", "frame_%04d.png"}) {
       SCOPED_TRACE(signal + " " + output);
@@ -664,7 +658,7 @@ TEST(ConvertVideo, HangupAndQuitLeaveNothing) {
 // Under nohup (SIGHUP ignored when nelf starts) a closed terminal does not stop the conversion.
 TEST(ConvertVideo, IgnoredHangupKeepsConverting) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   const auto r = run_command("trap '' HUP; " + std::string(NELF_BINARY) + " convert synthetic:duration=3,size=160x90 " +
                              q(dir / "out.mkv") + " --quiet --codec utvideo --profile " + q(profile) +
                              " & pid=$!; sleep 1; kill -HUP $pid; wait $pid; echo status $?");
@@ -678,7 +672,7 @@ TEST(ConvertVideo, IgnoredHangupKeepsConverting) {
 // no temporary file and no truncated image.
 TEST(ConvertVideo, DiskFullLeavesNothing) {
   TempDir dir;
-  const auto profile = small_profile(dir);
+  const auto profile = write_small_profile(dir);
   for (const std::string output : {"out.mkv", "frame_%04d.png"}) {
     SCOPED_TRACE(output);
     // 64 blocks: 32 KiB under dash (512-byte blocks), 64 KiB under bash; a frame is more than that.

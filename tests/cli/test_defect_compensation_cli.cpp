@@ -17,12 +17,11 @@
 namespace nelf {
 namespace {
 
+using test::q;
 using test::read_back;
 using test::run_nelf;
 using test::shell_quote;
 using test::TempDir;
-
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
 
 // The small 160×90 test panel, with the defect map or without.
 std::string small_profile_text(bool with_map) {

@@ -15,8 +15,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
 TEST(IpcCli, SocatDrivesThePlayerWithMpvsJson) {
   TempDir dir;
   const auto sock = dir / "nelf.sock";

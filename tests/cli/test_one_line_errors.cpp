@@ -13,11 +13,10 @@ namespace nelf {
 namespace {
 
 using test::expect_clean_failure;
+using test::q;
 using test::run_nelf;
 using test::shell_quote;
 using test::TempDir;
-
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
 
 // Bytes a terminal would act on: C0 controls (the final newline aside), DEL, C1 controls in UTF-8.
 bool has_raw_controls(const std::string& err) {

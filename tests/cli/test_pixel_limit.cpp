@@ -16,10 +16,9 @@ namespace {
 
 using test::expect_clean_failure;
 using test::make_media;
+using test::q;
 using test::shell_quote;
 using test::TempDir;
-
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
 
 // A flat grey 8-bit PNG of `width` x `height`, written row by row: a decompression bomb (16384x16384
 // is 268 Mpx in about a megabyte) made in seconds and a few KB of memory.

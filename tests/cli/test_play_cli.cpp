@@ -23,10 +23,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
-std::filesystem::path small_profile(const TempDir& dir) { return test::write_small_profile(dir); }
-
 // Side by side at `fps` for `seconds`: left red-ish, right blue-ish, a moving white box, and a
 // 440 Hz tone unless `audio` is false.
 std::filesystem::path make_clip(const TempDir& dir, const std::string& name, double seconds, int fps,
@@ -55,7 +51,7 @@ class PlayCli : public ::testing::Test {
 TEST_F(PlayCli, PlaysToTheEndInSyncWithTheAudioClockAndExitsCleanly) {
   const auto clip = make_clip(dir_, "clip.mp4", 2, 30);
   const auto log = dir_ / "frames.csv";
-  const auto r = run_command(env() + NELF_BINARY + " play " + q(clip) + " --profile " + q(small_profile(dir_)) +
+  const auto r = run_command(env() + NELF_BINARY + " play " + q(clip) + " --profile " + q(write_small_profile(dir_)) +
                              " --log-frames " + q(log));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("nelf: sound: dummy, 48000 Hz"), std::string::npos) << r.err;
@@ -102,7 +98,7 @@ TEST_F(PlayCli, VideoStartingAfterItsSoundStillStarts) {
                                               " -f lavfi -i sine=f=440:r=48000:d=" + d +
                                               " -c:v libx264 -preset ultrafast -pix_fmt yuv420p -c:a aac");
   const auto r = run_command("timeout 60 env " + env() + NELF_BINARY + " play " + q(clip) + " --layout sbs-half" +
-                             " --profile " + q(small_profile(dir_)));
+                             " --profile " + q(write_small_profile(dir_)));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("nelf: sound: dummy"), std::string::npos) << r.err;
   long shown = 0, repeated = 0, dropped = 0;
@@ -127,7 +123,7 @@ TEST_F(PlayCli, TenBitVideoIsCompositedAheadAsEightBitIs) {
     SCOPED_TRACE(input.filename().string());
     const auto log = dir_ / "frames.csv";
     const auto r = run_command(env() + NELF_BINARY + " play " + q(input) + " --no-audio --profile " +
-                               q(small_profile(dir_)) + " --log-frames " + q(log));
+                               q(write_small_profile(dir_)) + " --log-frames " + q(log));
     ASSERT_EQ(r.status, 0) << r.err;
     int shown = 0, ahead = 0;
     for (const auto& row : read_log(log))
@@ -143,7 +139,7 @@ TEST_F(PlayCli, NoAudioFlagPlaysOnTheSystemClock) {
   const auto clip = make_clip(dir_, "clip.mp4", 1, 24);
   const auto log = dir_ / "frames.csv";
   const auto r = run_command(env() + NELF_BINARY + " play " + q(clip) + " --no-audio --profile " +
-                             q(small_profile(dir_)) + " --log-frames " + q(log));
+                             q(write_small_profile(dir_)) + " --log-frames " + q(log));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("nelf: --no-audio: playing without sound\n"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("frames shown"), std::string::npos) << r.err;
@@ -155,8 +151,8 @@ TEST_F(PlayCli, NoAudioFlagPlaysOnTheSystemClock) {
 
 TEST_F(PlayCli, NoAudioDeviceSaysWhyAndPlaysWithoutSound) {
   const auto clip = make_clip(dir_, "clip.mp4", 1, 24);
-  const auto r =
-      run_command(env("no-such-driver") + NELF_BINARY + " play " + q(clip) + " --profile " + q(small_profile(dir_)));
+  const auto r = run_command(env("no-such-driver") + NELF_BINARY + " play " + q(clip) + " --profile " +
+                             q(write_small_profile(dir_)));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("nelf: no audio device ("), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("): playing without sound\n"), std::string::npos) << r.err;
@@ -165,7 +161,7 @@ TEST_F(PlayCli, NoAudioDeviceSaysWhyAndPlaysWithoutSound) {
 
 TEST_F(PlayCli, AFileWithoutSoundPlaysOnTheSystemClock) {
   const auto clip = make_clip(dir_, "clip.mp4", 1, 24, false);
-  const auto r = run_command(env() + NELF_BINARY + " play " + q(clip) + " --profile " + q(small_profile(dir_)));
+  const auto r = run_command(env() + NELF_BINARY + " play " + q(clip) + " --profile " + q(write_small_profile(dir_)));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("nelf: no audio stream: playing without sound\n"), std::string::npos) << r.err;
 }
@@ -174,7 +170,7 @@ TEST_F(PlayCli, AFileWithoutSoundPlaysOnTheSystemClock) {
 TEST_F(PlayCli, TheSyntheticClipPlaysItsTone) {
   const auto log = dir_ / "frames.csv";
   const auto r = run_command(env() + NELF_BINARY + " play synthetic:duration=1,size=160x90 --profile " +
-                             q(small_profile(dir_)) + " --log-frames " + q(log));
+                             q(write_small_profile(dir_)) + " --log-frames " + q(log));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("nelf: sound: dummy, 48000 Hz"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("playing without sound"), std::string::npos) << r.err;
@@ -189,7 +185,7 @@ TEST_F(PlayCli, TheSyntheticClipPlaysItsTone) {
 TEST_F(PlayCli, InterruptExitsWith130AndTheSummary) {
   const auto clip = make_clip(dir_, "long.mp4", 20, 24, false);
   const auto r =
-      run_command(env() + std::string(NELF_BINARY) + " play " + q(clip) + " --profile " + q(small_profile(dir_)) +
+      run_command(env() + std::string(NELF_BINARY) + " play " + q(clip) + " --profile " + q(write_small_profile(dir_)) +
                   " & pid=$!; sleep 3; kill -INT $pid; (sleep 30; kill -KILL $pid) 2>/dev/null & guard=$!; "
                   "wait $pid; status=$?; kill $guard; echo status $status");
   EXPECT_NE(r.out.find("status 130\n"), std::string::npos) << r.out << r.err;
@@ -202,7 +198,7 @@ TEST_F(PlayCli, ArrowKeySeeksForwardAndQQuits) {
   const auto clip = make_clip(dir_, "long.mp4", 30, 24, false);
   const auto log = dir_ / "frames.csv";
   const auto r = run_command(
-      env() + std::string(NELF_BINARY) + " play " + q(clip) + " --profile " + q(small_profile(dir_)) +
+      env() + std::string(NELF_BINARY) + " play " + q(clip) + " --profile " + q(write_small_profile(dir_)) +
       " --log-frames " + q(log) +
       " & pid=$!; (sleep 60; kill -KILL $pid) 2>/dev/null & guard=$!; export DISPLAY=" + xvfb_.display_name() +
       "; w=$(timeout 20 xdotool search --sync --name '^nelf: ' | head -1); sleep 1.5; xdotool key --window $w Right; "
@@ -226,7 +222,7 @@ TEST_F(PlayCli, ArrowKeySeeksForwardAndQQuits) {
 TEST_F(PlayCli, HPrintsTheKeyHelpFromTheTable) {
   const auto clip = make_clip(dir_, "long.mp4", 30, 24, false);
   const auto r = run_command(
-      env() + std::string(NELF_BINARY) + " play " + q(clip) + " --profile " + q(small_profile(dir_)) +
+      env() + std::string(NELF_BINARY) + " play " + q(clip) + " --profile " + q(write_small_profile(dir_)) +
       " & pid=$!; (sleep 60; kill -KILL $pid) 2>/dev/null & guard=$!; export DISPLAY=" + xvfb_.display_name() +
       "; w=$(timeout 20 xdotool search --sync --name '^nelf: ' | head -1); sleep 1.5; xdotool key --window $w h; "
       "sleep 1; xdotool key --window $w q; wait $pid; status=$?; kill $guard; echo status $status");
@@ -243,7 +239,7 @@ TEST_F(PlayCli, ATruncatedFilePlaysWhatDecodesAndCountsTheLoss) {
   const std::string bytes = read_file(dir_ / "whole.mkv");
   write_file(dir_ / "cut.mkv", bytes.substr(0, bytes.size() / 2));
   const auto r =
-      run_command(env() + NELF_BINARY + " play " + q(dir_ / "cut.mkv") + " --profile " + q(small_profile(dir_)));
+      run_command(env() + NELF_BINARY + " play " + q(dir_ / "cut.mkv") + " --profile " + q(write_small_profile(dir_)));
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("video frames lost to decode errors"), std::string::npos) << r.err;
 }

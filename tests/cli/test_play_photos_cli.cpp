@@ -22,8 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string q(const fs::path& p) { return shell_quote(p.string()); }
-
 double first_shown_pts(const fs::path& log) {
   for (const LogRow& row : read_log(log))
     if (row.event == "shown") return row.pts;

@@ -14,8 +14,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
 class PlaySoundCli : public ::testing::Test {
  protected:
   TempDir dir_;
@@ -63,7 +61,7 @@ TEST_F(PlaySoundCli, AidNoPlaysWithoutSoundAndSaysSo) {
 }
 
 // One line after the input's: the error, naming the tracks there are; nothing played.
-void expect_one_line_error(const CommandResult& r, const std::string& line) {
+void expect_track_error(const CommandResult& r, const std::string& line) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("nelf: " + line + "\n"), std::string::npos) << r.err;
   EXPECT_LE(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
@@ -73,13 +71,13 @@ void expect_one_line_error(const CommandResult& r, const std::string& line) {
 
 TEST_F(PlaySoundCli, ATrackOrLanguageTheFileLacksIsOneLineListingItsTracks) {
   const std::string tracks = "the input has track 1: eng, aac, 2 channels (default); track 2: ger, ac3, 6 channels";
-  expect_one_line_error(play("--aid 3"), "no audio track 3 (--aid): " + tracks);
-  expect_one_line_error(play("--alang fre,ita"), "no audio track in fre,ita (--alang): " + tracks);
+  expect_track_error(play("--aid 3"), "no audio track 3 (--aid): " + tracks);
+  expect_track_error(play("--alang fre,ita"), "no audio track in fre,ita (--alang): " + tracks);
 }
 
 TEST_F(PlaySoundCli, BadAidAndVolumeValuesAreOneLine) {
-  expect_one_line_error(play("--aid 0"), "--aid 0: a track number from 1, auto or no");
-  expect_one_line_error(play("--aid two"), "--aid two: a track number from 1, auto or no");
+  expect_track_error(play("--aid 0"), "--aid 0: a track number from 1, auto or no");
+  expect_track_error(play("--aid two"), "--aid two: a track number from 1, auto or no");
   const auto r = play("--volume 131");
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("--volume"), std::string::npos) << r.err;

@@ -20,8 +20,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
 // Splices MVC NAL units into an Annex B H.264 stream: a subset SPS after each PPS, a slice
 // extension (view 1) after each slice of the base view.
 void splice_mvc(const std::filesystem::path& from, const std::filesystem::path& to) {
@@ -80,14 +78,14 @@ void add_hevc_layer(const std::filesystem::path& from, const std::filesystem::pa
       .write(reinterpret_cast<const char*>(out.data()), static_cast<std::streamsize>(out.size()));
 }
 
-CommandResult probe(const std::filesystem::path& path, const std::string& extra = "") {
+CommandResult nelf_probe(const std::filesystem::path& path, const std::string& extra = "") {
   return run_nelf("probe " + extra + " " + q(path));
 }
 
 TEST(ProbeStreams, JsonListsEveryStreamChapterAndAttachment) {
   TempDir dir;
   const auto path = make_release_mkv(dir.path());
-  const CommandResult r = probe(path, "--json");
+  const CommandResult r = nelf_probe(path, "--json");
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   const nlohmann::json& streams = j["streams"];
@@ -124,7 +122,7 @@ TEST(ProbeStreams, JsonListsEveryStreamChapterAndAttachment) {
 
 TEST(ProbeStreams, PlainSummaryHasALinePerStreamAndChapter) {
   TempDir dir;
-  const CommandResult r = probe(make_release_mkv(dir.path()));
+  const CommandResult r = nelf_probe(make_release_mkv(dir.path()));
   ASSERT_EQ(r.status, 0) << r.err;
   for (const std::string line :
        {"  #1 audio ac3 5.1(side), 48000 Hz [eng] \"Surround 5.1\"\n", "  #3 subtitle subrip [eng] (default)\n",
@@ -137,7 +135,7 @@ TEST(ProbeStreams, StereoMetadataPerStream) {
   TempDir dir;
   const auto path = make_media(dir / "tb.mkv",
                                two_colour_input(64, 36, true, 3) + " -c:v ffv1 -metadata:s:v:0 stereo_mode=top_bottom");
-  const nlohmann::json j = nlohmann::json::parse(probe(path, "--json").out);
+  const nlohmann::json j = nlohmann::json::parse(nelf_probe(path, "--json").out);
   EXPECT_EQ(j["streams"][0]["stereo_metadata"]["type"], "top-bottom") << j.dump();
 }
 
@@ -155,7 +153,7 @@ TEST_F(MvcStream, ProbeReportsItAndShowsIt2D) {
   make_media(dir_ / "mvc.ts", "-r 10 -i " + q(dir_ / "mvc.h264") + " -c copy");
   make_media(dir_ / "mvc.mkv", "-r 10 -i " + q(dir_ / "mvc.h264") + " -c copy");
   for (const char* name : {"mvc.h264", "mvc.ts", "mvc.mkv"}) {
-    const CommandResult r = probe(dir_ / name, "--json");
+    const CommandResult r = nelf_probe(dir_ / name, "--json");
     ASSERT_EQ(r.status, 0) << name << ": " << r.err;
     const nlohmann::json j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["multiview"], "H.264 MVC") << name;
@@ -166,10 +164,10 @@ TEST_F(MvcStream, ProbeReportsItAndShowsIt2D) {
     EXPECT_NE(r.err.find("H.264 MVC stereo: FFmpeg decodes only its base view, so it plays in 2D"), std::string::npos)
         << r.err;
   }
-  const CommandResult plain = probe(dir_ / "mvc.h264");
+  const CommandResult plain = nelf_probe(dir_ / "mvc.h264");
   EXPECT_NE(plain.out.find("multiview: H.264 MVC"), std::string::npos) << plain.out;
   // The base view alone is an ordinary stream.
-  const nlohmann::json base = nlohmann::json::parse(probe(dir_ / "base.h264", "--json").out);
+  const nlohmann::json base = nlohmann::json::parse(nelf_probe(dir_ / "base.h264", "--json").out);
   EXPECT_EQ(base["multiview"], nullptr);
   EXPECT_EQ(base["rule"], "default");
 }
@@ -186,7 +184,7 @@ TEST_F(MvcStream, ConvertAndPlaySayWhyItIs2D) {
   ASSERT_EQ(p.status, 0) << p.err;
   EXPECT_NE(p.err.find("H.264 MVC stereo: FFmpeg decodes only its base view"), std::string::npos) << p.err;
   // --layout still decides: the user knows better than nelf.
-  const nlohmann::json j = nlohmann::json::parse(probe(dir_ / "mvc.h264", "--json --layout sbs-half").out);
+  const nlohmann::json j = nlohmann::json::parse(nelf_probe(dir_ / "mvc.h264", "--json --layout sbs-half").out);
   EXPECT_EQ(j["rule"], "flag");
   EXPECT_EQ(j["multiview"], "H.264 MVC");
 }
@@ -198,20 +196,20 @@ TEST(ProbeStreams, MvHevcRawAndInMp4) {
   add_hevc_layer(dir / "base.hevc", dir / "mv.hevc");
   make_media(dir / "mv.mp4", "-r 10 -i " + q(dir / "mv.hevc") + " -c copy");  // hvcC, length-prefixed
   for (const char* name : {"mv.hevc", "mv.mp4"}) {
-    const CommandResult r = probe(dir / name, "--json");
+    const CommandResult r = nelf_probe(dir / name, "--json");
     ASSERT_EQ(r.status, 0) << name << ": " << r.err;
     const nlohmann::json j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["multiview"], "MV-HEVC") << name;
     EXPECT_EQ(j["rule"], "multiview") << name;
     EXPECT_NE(r.err.find("MV-HEVC stereo: FFmpeg decodes only its base view"), std::string::npos) << r.err;
   }
-  EXPECT_EQ(nlohmann::json::parse(probe(dir / "base.hevc", "--json").out)["multiview"], nullptr);
+  EXPECT_EQ(nlohmann::json::parse(nelf_probe(dir / "base.hevc", "--json").out)["multiview"], nullptr);
 }
 
 TEST(ProbeStreams, BadInputsFailInOneLine) {
   TempDir dir;
   write_file(dir / "fake.h264", std::string("\x00\x00\x01\x74\x00\x00\x47", 7) + "not really video");
-  const CommandResult r = probe(dir / "fake.h264", "--json");
+  const CommandResult r = nelf_probe(dir / "fake.h264", "--json");
   EXPECT_NE(r.status, 0);
   EXPECT_LT(r.status, 128);
   EXPECT_TRUE(r.out.empty()) << r.out;

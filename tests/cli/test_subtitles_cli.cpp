@@ -18,8 +18,6 @@
 namespace nelf::test {
 namespace {
 
-std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
-
 const char* const kSrt = "1\n00:00:00,000 --> 00:00:05,000\nHELLO 3D WORLD\n\n";
 
 // The packed frame of a one-image conversion, as RGB24 bytes, and its width.

@@ -72,9 +72,9 @@ TEST(SubtitleOverlay, BlendsPremultipliedOverEightAndSixteenBits) {
   EXPECT_EQ(eight.left[3], 255);
   StereoVideoFrame sixteen = grey_frame(1, 1, 16);
   draw_subtitles(sixteen, half, 0.0);
-  std::uint16_t red = 0;
-  std::memcpy(&red, sixteen.left.data(), 2);
-  EXPECT_EQ(red, 128 * 257 + (0x4040 * 127L + 127) / 255);
+  std::uint16_t red_sample = 0;
+  std::memcpy(&red_sample, sixteen.left.data(), 2);
+  EXPECT_EQ(red_sample, 128 * 257 + (0x4040 * 127L + 127) / 255);
 }
 
 TEST(SubtitleOverlay, BlockMeansTakeASubtitleOfTheirOwnSize) {

@@ -5,6 +5,8 @@
 
 namespace nelf {
 namespace {
+// This file's own names: its suite is compiled as one unit (tests/CMakeLists.txt).
+namespace test_packing {
 
 Image filled(int w, int h, Rgba colour) {
   Image image(w, h);
@@ -173,5 +175,6 @@ TEST(Packing, RejectsMismatchedEyes) {
   EXPECT_TRUE(same(pack_eyes(signal("sbs"), eyes).at(8, 0), kRight));
 }
 
+}  // namespace test_packing
 }  // namespace
 }  // namespace nelf

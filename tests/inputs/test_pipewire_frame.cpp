@@ -15,6 +15,8 @@
 
 namespace nelf {
 namespace {
+// This file's own names: its suite is compiled as one unit (tests/CMakeLists.txt).
+namespace test_pipewire_frame {
 
 constexpr int kWidth = 64, kHeight = 36;
 
@@ -233,5 +235,6 @@ TEST(PipeWireFrameReader, ABufferShortOfItsFormatOrMarkedCorruptedIsNoFrame) {
   EXPECT_FALSE(grey.read(f.finish()));
 }
 
+}  // namespace test_pipewire_frame
 }  // namespace
 }  // namespace nelf

@@ -19,6 +19,8 @@
 
 namespace nelf {
 namespace {
+// This file's own names: its suite is compiled as one unit (tests/CMakeLists.txt).
+namespace test_source_audio {
 
 using test::ScopedEnv;
 
@@ -135,5 +137,6 @@ TEST_F(SourceAudioTest, PlayPlaysTheSyntheticClipsToneAndSaysWhyAFileHasNoSound)
   EXPECT_EQ(off.description(), "--no-audio");
 }
 
+}  // namespace test_source_audio
 }  // namespace
 }  // namespace nelf

@@ -10,6 +10,8 @@
 
 namespace nelf {
 namespace {
+// This file's own names: its suite is compiled as one unit (tests/CMakeLists.txt).
+namespace test_subtitle_track {
 
 using test::TempDir;
 
@@ -96,5 +98,6 @@ TEST(SubtitleTrack, AFileThatIsNoSubtitlesIsOneLine) {
   EXPECT_FALSE(SubtitleTrack::has_subtitles((dir / "none.srt").string()));
 }
 
+}  // namespace test_subtitle_track
 }  // namespace
 }  // namespace nelf

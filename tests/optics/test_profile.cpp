@@ -10,6 +10,8 @@
 
 namespace nelf {
 namespace {
+// This file's own names: its suite is compiled as one unit (tests/CMakeLists.txt).
+namespace test_profile {
 
 const char* minimal_lens_profile = R"(
 name = "test"
@@ -352,5 +354,6 @@ TEST(ProfileErrors, ArraysAreShownOnOneLineAndCutShort) {
   EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 }
 
+}  // namespace test_profile
 }  // namespace
 }  // namespace nelf

@@ -15,6 +15,8 @@
 
 namespace nelf {
 namespace {
+// This file's own names: its suite is compiled as one unit (tests/CMakeLists.txt).
+namespace test_defect_marking {
 
 using Named = KeyPress::Named;
 using test::TempDir;
@@ -313,5 +315,6 @@ TEST(DefectMarking, SavedMapAndProfileReadBack) {
   }
 }
 
+}  // namespace test_defect_marking
 }  // namespace
 }  // namespace nelf

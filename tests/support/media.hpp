@@ -8,6 +8,9 @@
 
 namespace nelf::test {
 
+// The ffmpeg CLI's arguments for a quick H.264 stream that every FFmpeg build decodes.
+inline const std::string h264 = " -c:v libx264 -preset ultrafast -pix_fmt yuv420p";
+
 // Runs `ffmpeg ARGS OUTPUT` quietly, overwriting OUTPUT; throws with ffmpeg's own message on failure
 // so that a broken generator shows up as such and not as a decoder bug. lavfi sources are endless:
 // ARGS must bound them (-frames:v, d=, -shortest); the timeout catches a forgotten bound.

@@ -70,6 +70,8 @@ std::filesystem::path write_lavfi_still(const TempDir& dir, const std::string& n
 
 // Quotes a string for /bin/sh.
 std::string shell_quote(const std::string& s);
+// A path quoted for /bin/sh: the shorthand the command lines of the tests are written with.
+inline std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
 
 // The hmz-t1 optics (1.0 mm / f 3.3 mm sheet, 25 mm eye relief, image at 1 m) on half the pixels per
 // axis at twice the pitch (640x360 at 24 um): the same lens block, field of view, eye box and beams,

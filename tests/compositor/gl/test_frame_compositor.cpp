@@ -20,6 +20,8 @@
 
 namespace nelf {
 namespace {
+// This file's own names: its suite is compiled as one unit (tests/CMakeLists.txt).
+namespace test_frame_compositor {
 
 using test::block_means;
 using Bytes = std::vector<std::uint8_t>;
@@ -367,5 +369,6 @@ TEST(FrameCompositor, StillsAreTheComposedEyesPackedBySignal) {
   }
 }
 
+}  // namespace test_frame_compositor
 }  // namespace
 }  // namespace nelf

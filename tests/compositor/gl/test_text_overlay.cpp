@@ -13,6 +13,8 @@
 
 namespace nelf {
 namespace {
+// This file's own names: its suite is compiled as one unit (tests/CMakeLists.txt).
+namespace test_text_overlay {
 
 std::vector<float> texture_pixels(GLuint texture, int width, int height) {
   std::vector<float> pixels(static_cast<std::size_t>(width) * height * 4);
@@ -201,5 +203,6 @@ TEST_F(TextOverlayTest, EmptyTextPassesTheViewThrough) {
   EXPECT_EQ(overlay.apply(Eye::right, view).texture, view.texture);
 }
 
+}  // namespace test_text_overlay
 }  // namespace
 }  // namespace nelf

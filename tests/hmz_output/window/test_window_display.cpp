@@ -24,6 +24,8 @@
 
 namespace nelf {
 namespace {
+// This file's own names: its suite is compiled as one unit (tests/CMakeLists.txt).
+namespace test_window_display {
 
 using Rgb = std::array<int, 3>;
 
@@ -468,5 +470,6 @@ TEST(WindowDisplayErrors, QuadBufferNeedsBothEyes) {
   EXPECT_THROW(display_driver("quad-buffer").open_display(options), std::invalid_argument);
 }
 
+}  // namespace test_window_display
 }  // namespace
 }  // namespace nelf
