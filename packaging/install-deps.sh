@@ -25,8 +25,9 @@ packages=(
   # media: FFmpeg libraries, the ffmpeg CLI for test media and benchmarks, OpenImageIO
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libswresample-dev libavfilter-dev libavdevice-dev
   ffmpeg libopenimageio-dev libpng-dev
-  # stereo matching for the estimated depth (inputs/stereo_matcher): OpenCV's block matcher
-  libopencv-dev
+  # stereo matching for the estimated depth (inputs/stereo_matcher): OpenCV's block matcher, its
+  # three modules alone (libopencv-dev would add every other module, 42 packages, 315 MB)
+  libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev
   # maths, configuration, CLI, formatting, JSON, audio, subtitles (libass)
   libglm-dev libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libsdl2-dev libass-dev
   # tests (zsh and fish: the completion checks run them)
