@@ -79,8 +79,8 @@ StreamTiming timing(const std::filesystem::path& path, const std::string& stream
 std::string half_sbs_with_audio(const std::string& audio, double seconds, const std::string& rate = "24",
                                 double video_delay = 0.012) {
   return "-itsoffset " + std::to_string(video_delay) + " -f lavfi -i testsrc2=s=320x180:r=" + rate +
-         " -f lavfi -i sine=frequency=440:sample_rate=48000 -t " + std::to_string(seconds) +
-         " -map 0:v -map 1:a -c:v libx264 -preset ultrafast -pix_fmt yuv420p -c:a " + audio;
+         " -f lavfi -i sine=frequency=440:sample_rate=48000 -t " + std::to_string(seconds) + " -map 0:v -map 1:a" +
+         h264 + " -c:a " + audio;
 }
 
 // How long one audio frame (packet) of `codec` at 48 kHz lasts: the audio of an output starts
@@ -195,8 +195,8 @@ TEST(ConvertTimestamps, CleanVariableFrameRateFileIsNotDamaged) {
   const auto profile = write_small_profile(dir);
   // 40 frames; frame n lasts (1 + n mod 5) / 30 s: 4 s in all, a mean of 10 fps.
   const std::string vfr = "-f lavfi -i testsrc2=s=320x180:r=30 -frames:v 40 -vf " +
-                          shell_quote("setpts='(15*floor(N/5) + mod(N,5)*(mod(N,5)+1)/2)/30/TB'") +
-                          " -fps_mode vfr -c:v libx264 -preset ultrafast -pix_fmt yuv420p";
+                          shell_quote("setpts='(15*floor(N/5) + mod(N,5)*(mod(N,5)+1)/2)/30/TB'") + " -fps_mode vfr" +
+                          h264;
   for (const std::string name : {"vfr.mkv", "vfr.mp4"}) {
     SCOPED_TRACE(name);
     make_media(dir / name, vfr);

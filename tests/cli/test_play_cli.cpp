@@ -34,7 +34,8 @@ std::filesystem::path make_clip(const TempDir& dir, const std::string& name, dou
   if (audio) args += " -f lavfi -i sine=f=440:r=48000:d=" + d;
   args +=
       " -filter_complex \"[2]split[b1][b2];[0][b1]overlay=x='mod(n*5,300)':y=60[l];"
-      "[1][b2]overlay=x='mod(n*5,300)':y=60[r];[l][r]hstack\" -c:v libx264 -preset ultrafast -pix_fmt yuv420p";
+      "[1][b2]overlay=x='mod(n*5,300)':y=60[r];[l][r]hstack\"" +
+      h264;
   if (audio) args += " -c:a aac -shortest";
   return make_media(dir / name, args);
 }
@@ -95,8 +96,7 @@ TEST_F(PlayCli, VideoStartingAfterItsSoundStillStarts) {
   const std::string d = "1";
   const auto clip =
       make_media(dir_ / "late-video.mkv", "-itsoffset 0.3 -f lavfi -i color=c=0xC03020:s=320x90:r=24:d=" + d +
-                                              " -f lavfi -i sine=f=440:r=48000:d=" + d +
-                                              " -c:v libx264 -preset ultrafast -pix_fmt yuv420p -c:a aac");
+                                              " -f lavfi -i sine=f=440:r=48000:d=" + d + h264 + " -c:a aac");
   const auto r = run_command("timeout 60 env " + env() + NELF_BINARY + " play " + q(clip) + " --layout sbs-half" +
                              " --profile " + q(write_small_profile(dir_)));
   ASSERT_EQ(r.status, 0) << r.err;

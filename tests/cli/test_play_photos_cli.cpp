@@ -46,8 +46,7 @@ class PlayPhotos : public ::testing::Test {
     return write_lavfi_still(dir_, name, "color=c=" + colour + ":s=64x18");
   }
   fs::path clip(const std::string& name, double seconds) {
-    return make_media(dir_ / name, "-f lavfi -i testsrc=s=128x36:r=24:d=" + std::to_string(seconds) +
-                                       " -c:v libx264 -preset ultrafast -pix_fmt yuv420p");
+    return make_media(dir_ / name, "-f lavfi -i testsrc=s=128x36:r=24:d=" + std::to_string(seconds) + h264);
   }
   std::vector<fs::path> records() const {
     std::vector<fs::path> files;
@@ -242,8 +241,7 @@ TEST_F(PlayPhotos, CtrlSWritesThePackedFrameAsConvertDoes) {
 // as the s key left them; written by a worker, so play goes on meanwhile.
 TEST_F(PlayPhotos, CtrlVWritesTheViewsSideBySideWithTheSubtitles) {
   // Half side by side: red left, blue right, each squeezed to 160x180 of a 320x180 frame.
-  make_media(dir_ / "movie.mkv",
-             two_colour_input(160, 180, false, 20, 10) + " -c:v libx264 -preset ultrafast -pix_fmt yuv420p");
+  make_media(dir_ / "movie.mkv", two_colour_input(160, 180, false, 20, 10) + h264);
   write_file(dir_ / "movie.srt", "1\n00:00:00,000 --> 00:00:05,000\nHELLO WORLD\n\n");
   const fs::path shots = dir_ / "shots";
   fs::create_directories(shots);

@@ -58,8 +58,7 @@ class SubtitlesCli : public ::testing::Test {
   void SetUp() override {
     profile_ = write_small_profile(dir_);
     // Two grey views side by side, the same video stream in an MP4 and, with the SRT muxed in, an MKV.
-    make_media(dir_ / "plain.mp4",
-               "-f lavfi -i color=c=gray:s=640x180:r=10:d=1 -c:v libx264 -preset ultrafast -pix_fmt yuv420p");
+    make_media(dir_ / "plain.mp4", "-f lavfi -i color=c=gray:s=640x180:r=10:d=1" + h264);
     write_file(dir_ / "lines.txt", kSrt);
     make_media(dir_ / "embedded.mkv", "-i " + q(dir_ / "plain.mp4") + " -f srt -i " + q(dir_ / "lines.txt") +
                                           " -map 0 -map 1 -c:v copy -c:s srt");

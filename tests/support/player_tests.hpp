@@ -35,7 +35,8 @@ inline std::filesystem::path make_clip(const TempDir& dir, int seconds = 2) {
           " -f lavfi -i color=c=white:s=20x60:r=30" + d +
           " -filter_complex "
           "\"[2]split[b1][b2];[0][b1]overlay=x='mod(n*5,300)':y=60[l];[1][b2]overlay=x='mod(n*5,300)':y=60[r];"
-          "[l][r]hstack\" -c:v libx264 -preset ultrafast -pix_fmt yuv420p");
+          "[l][r]hstack\"" +
+          h264);
 }
 
 struct Mean {

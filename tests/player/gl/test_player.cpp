@@ -592,8 +592,7 @@ TEST_F(PlayerTest, KeyOShowsTheTimeLineAndSeekBarInBothEyes) {
 }
 
 TEST_F(PlayerTest, OnASteppedClockEachFrameIsShownAtTheRefreshTheSchedulerChooses) {
-  const auto clip = test::make_media(dir_ / "24fps.mp4", test::two_colour_input(320, 180, false, 48, 24) +
-                                                             " -c:v libx264 -preset ultrafast -pix_fmt yuv420p");
+  const auto clip = test::make_media(dir_ / "24fps.mp4", test::two_colour_input(320, 180, false, 48, 24) + test::h264);
   PlayerOptions options = silent_options();
   options.clock = std::make_shared<playback::SteppedClock>();
   options.log_frames = (dir_ / "frames.csv").string();
