@@ -17,7 +17,7 @@ namespace {
 using test::files_in;
 using test::read_back;
 using test::run_nelf;
-using test::shell_quote;
+using test::q;
 using test::TempDir;
 
 float luma(const test::ReadBack& img, int x, int y) {
@@ -53,7 +53,7 @@ TEST(CalibrateCli, EveryPatternIsAFramePackedImage) {
   TempDir dir;
   for (const std::string pattern : {"stripes", "grid", "snellen", "white"}) {
     const auto out = dir / (pattern + ".png");
-    const auto r = run_nelf("calibrate --pattern " + pattern + " --output " + shell_quote(out.string()));
+    const auto r = run_nelf("calibrate --pattern " + pattern + " --output " + q(out));
     ASSERT_EQ(r.status, 0) << pattern << ": " << r.err;
     EXPECT_EQ(r.err, "");
     const auto img = read_back(out);
@@ -70,7 +70,7 @@ TEST(CalibrateCli, StripesArePeriodicOnThePanel) {
   // of 5 view pixels (three display pixels, rounded), so 3.33 panel pixels per stripe.
   TempDir dir;
   const auto out = dir / "stripes.png";
-  const auto r = run_nelf("calibrate --profile hmz-t1-stock --pattern stripes --output " + shell_quote(out.string()));
+  const auto r = run_nelf("calibrate --profile hmz-t1-stock --pattern stripes --output " + q(out));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto img = read_back(out);
   for (const int top : {0, 750}) {  // each eye
@@ -88,7 +88,7 @@ TEST(CalibrateCli, StripesArePeriodicOnThePanel) {
   // Through the lens array (hmz-t1) each elemental image shows the stripes too: runs of about three
   // display pixels inside every lenslet's image along a column of the left eye.
   const auto lf = dir / "lf.png";
-  ASSERT_EQ(run_nelf("calibrate --pattern stripes --output " + shell_quote(lf.string())).status, 0);
+  ASSERT_EQ(run_nelf("calibrate --pattern stripes --output " + q(lf)).status, 0);
   const auto lf_img = read_back(lf);
   const auto lf_runs = runs_down(lf_img, 600, 0, 720);
   const long regular = std::count_if(lf_runs.begin(), lf_runs.end(), [](int n) { return n >= 2 && n <= 4; });
@@ -98,7 +98,7 @@ TEST(CalibrateCli, StripesArePeriodicOnThePanel) {
 TEST(CalibrateCli, ProfileAndSignalOptions) {
   TempDir dir;
   const auto out = dir / "grid.png";
-  const auto r = run_nelf("calibrate --pattern grid --signal sbs --output " + shell_quote(out.string()));
+  const auto r = run_nelf("calibrate --pattern grid --signal sbs --output " + q(out));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto img = read_back(out);
   EXPECT_EQ(img.width, 2560);
@@ -115,8 +115,7 @@ TEST(CalibrateCli, DefectsWritesThePackedFlatFieldWithTheKnownDefectsRinged) {
   test::write_file(dir / "panel.defects", "left 100 100 dead\nright 200 50 stuck 255 255 255\n");
   test::write_file(dir / "mine.toml", profile_to_toml(profile));
   const auto out = dir / "red.png";
-  const auto r = run_nelf("calibrate --defects --field red --profile " + shell_quote((dir / "mine.toml").string()) +
-                          " --output " + shell_quote(out.string()));
+  const auto r = run_nelf("calibrate --defects --field red --profile " + q(dir / "mine.toml") + " --output " + q(out));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err, "");
   const auto img = read_back(out);
@@ -145,13 +144,13 @@ TEST(CalibrateCli, DefectsWritesThePackedFlatFieldWithTheKnownDefectsRinged) {
   EXPECT_TRUE(is(202, 750 + 52, 0, 1, 1));
   // The default field is black.
   const auto black = dir / "black.png";
-  ASSERT_EQ(run_nelf("calibrate --defects --output " + shell_quote(black.string())).status, 0);
+  ASSERT_EQ(run_nelf("calibrate --defects --output " + q(black)).status, 0);
   EXPECT_EQ(lit_pixels(read_back(black), 0, 1470), 0);
 }
 
 TEST(CalibrateCli, BadArgumentsSayWhatAndWriteNothing) {
   TempDir dir;
-  const std::string out = shell_quote((dir / "p.png").string());
+  const std::string out = q(dir / "p.png");
   struct Case {
     std::string args;
     int status;
@@ -163,12 +162,12 @@ TEST(CalibrateCli, BadArgumentsSayWhatAndWriteNothing) {
       {"--output " + out, 2,
        "nelf: --output " + (dir / "p.png").string() +
            " is an image file: give the pattern to write with --pattern stripes|grid|snellen|white\n"},
-      {"--pattern grid --output " + shell_quote((dir / "missing" / "p.png").string()), 1, "does not exist"},
-      {"--pattern grid --output " + shell_quote((dir / "p.bmpx").string()), 1, "p.bmpx"},
+      {"--pattern grid --output " + q(dir / "missing" / "p.png"), 1, "does not exist"},
+      {"--pattern grid --output " + q(dir / "p.bmpx"), 1, "p.bmpx"},
       {"--pattern grid --profile nosuch --output " + out, 2, "unknown profile 'nosuch'"},
       {"--pattern snellen --profile hmz-t1-stock --output " + out, 2,
        "nelf: pattern snellen: the Snellen chart needs the virtual screen's size"},
-      {"--pattern grid --save " + shell_quote((dir / "x.toml").string()) + " --output " + out, 2,
+      {"--pattern grid --save " + q(dir / "x.toml") + " --output " + out, 2,
        "nelf: --save keeps what the keys adjusted and needs a window"},
       {"--pattern grid --fsaa 3 --output " + out, 2, "fsaa"},
       {"--pattern grid --gpu 0", 2, "a live calibration renders on its display's GPU"},
@@ -176,9 +175,9 @@ TEST(CalibrateCli, BadArgumentsSayWhatAndWriteNothing) {
       {"--defects --pattern grid --output " + out, 2, "nelf: --defects shows flat fields, not --pattern grid"},
       {"--defects --fsaa 4 --output " + out, 2, "nelf: --fsaa antialiases the lens mapping"},
       {"--defects --field pink --output " + out, 2, "pink not in {black,white,red,green,blue}"},
-      {"--defects --save " + shell_quote((dir / "x.toml").string()) + " --output " + out, 2,
+      {"--defects --save " + q(dir / "x.toml") + " --output " + out, 2,
        "nelf: --save keeps what the keys marked and needs a window"},
-      {"--defects --save " + shell_quote((dir / "x.txt").string()), 2, "a profile is a .toml file"},
+      {"--defects --save " + q(dir / "x.txt"), 2, "a profile is a .toml file"},
   };
   for (const auto& c : cases) {
     const auto r = run_nelf("calibrate " + c.args);
@@ -194,7 +193,7 @@ TEST(CalibrateCli, DefectsKeepsAMapTheProfileDoesNotName) {
   // opens, the file left as it was.
   TempDir dir;
   test::write_file(dir / "mine.defects", "left 1 1 dead\n");
-  const auto r = run_nelf("calibrate --defects --output offscreen --save " + shell_quote((dir / "mine.toml").string()));
+  const auto r = run_nelf("calibrate --defects --output offscreen --save " + q(dir / "mine.toml"));
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(r.err, "nelf: --save " + (dir / "mine.toml").string() + ": " + (dir / "mine.defects").string() +
                        " exists and the profile names no defect map; to continue it, set correction.defect_map = "
@@ -216,11 +215,11 @@ TEST(CalibrateCli, ExistingOutputNeedsOverwrite) {
   TempDir dir;
   const auto out = dir / "p.png";
   test::write_file(out, "keep me");
-  auto r = run_nelf("calibrate --pattern white --output " + shell_quote(out.string()));
+  auto r = run_nelf("calibrate --pattern white --output " + q(out));
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("pass -y to overwrite"), std::string::npos) << r.err;
   EXPECT_EQ(test::read_file(out), "keep me");
-  r = run_nelf("calibrate --pattern white -y --output " + shell_quote(out.string()));
+  r = run_nelf("calibrate --pattern white -y --output " + q(out));
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(read_back(out).height, 1470);
 }

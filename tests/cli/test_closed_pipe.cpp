@@ -32,7 +32,7 @@ ClosedPipeResult run_into_closed_pipe(const std::string& command, int fd) {
   TempDir dir;
   const auto captured_path = dir / "captured";
   const std::string other = fd == 1 ? " 2>" : " >";
-  const std::string line = "exec " + command + other + shell_quote(captured_path.string()) + " </dev/null";
+  const std::string line = "exec " + command + other + q(captured_path) + " </dev/null";
   int fds[2];
   if (::pipe(fds) != 0) throw std::runtime_error("cannot make a pipe");
   ::close(fds[0]);  // nobody will read: every write fails (EPIPE) or raises SIGPIPE

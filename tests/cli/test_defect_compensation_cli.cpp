@@ -20,7 +20,7 @@ namespace {
 using test::q;
 using test::read_back;
 using test::run_nelf;
-using test::shell_quote;
+using test::q;
 using test::TempDir;
 
 // The small 160×90 test panel, with the defect map or without.

@@ -18,8 +18,8 @@ struct Converted {
   std::string frames, err;
 };
 Converted convert_raw(const TempDir& dir, const std::string& input, const std::string& args) {
-  const CommandResult r = run_nelf("convert " + shell_quote(input) + " - --profile " +
-                                   shell_quote(write_small_profile(dir).string()) + " --signal sbs " + args);
+  const CommandResult r = run_nelf("convert " + shell_quote(input) + " - --profile " + q(write_small_profile(dir)) +
+                                   " --signal sbs " + args);
   return {r.status, r.out, r.err};
 }
 
@@ -114,7 +114,7 @@ TEST(DepthCli, PlayShowsASyntheticSceneWithItsDepth) {
       run_command("env -u DISPLAY LP_NUM_THREADS=2 " + std::string(NELF_BINARY) +
                   " play synthetic:scene=planes,duration=0.5,size=320x180 --output offscreen --no-audio --depth auto "
                   "--profile " +
-                  shell_quote(write_small_profile(dir).string()));
+                  q(write_small_profile(dir)));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err.find("--depth"), std::string::npos) << r.err;
   unsigned shown = 0, repeated = 0, dropped = 0;

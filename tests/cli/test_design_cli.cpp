@@ -13,7 +13,7 @@ namespace nelf {
 namespace {
 
 using test::run_nelf;
-using test::shell_quote;
+using test::q;
 
 const char* valid_lens_profile = R"(name = "custom"
 [display]
@@ -89,7 +89,7 @@ focal_length_mm = 40.0
 eye_relief_mm = 20.0
 virtual_image_mm = 2000.0
 )");
-  const auto r = run_nelf("design --json --profile " + shell_quote(file.string()));
+  const auto r = run_nelf("design --json --profile " + q(file));
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json j = parse_one_object(r.out);
   EXPECT_EQ(j["profile"], "loupe");
@@ -113,7 +113,7 @@ TEST(DesignCli, TableMentionsTheKeyFigures) {
 TEST(DesignCli, PlotWritesAPngOfSensibleSize) {
   test::TempDir dir;
   const auto png = dir / "trade space.png";
-  const auto r = run_nelf("design --plot " + shell_quote(png.string()));
+  const auto r = run_nelf("design --plot " + q(png));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("146"), std::string::npos);  // the table is still printed
   OIIO::ImageBuf image(png.string());
@@ -131,7 +131,7 @@ TEST(DesignCli, PlotWritesAPngOfSensibleSize) {
 TEST(DesignCli, UnwritablePlotPathFailsCleanly) {
   test::TempDir dir;
   const auto png = dir / "no-such-dir" / "plot.png";
-  const auto r = run_nelf("design --plot " + shell_quote(png.string()));
+  const auto r = run_nelf("design --plot " + q(png));
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(count_lines(r.err), 1u) << r.err;
   EXPECT_NE(r.err.find(png.string()), std::string::npos) << r.err;
@@ -151,7 +151,7 @@ void expect_profile_error(const BadProfile& bad) {
   test::TempDir dir;
   const auto file = dir / (bad.name + ".toml");
   if (!bad.file_text.empty()) test::write_file(file, bad.file_text);
-  const auto r = run_nelf("design --profile " + shell_quote(file.string()));
+  const auto r = run_nelf("design --profile " + q(file));
   EXPECT_EQ(r.status, 2) << bad.name << ": " << r.err;
   EXPECT_EQ(r.out, "") << bad.name;
   EXPECT_EQ(count_lines(r.err), 1u) << bad.name << ": " << r.err;
@@ -256,7 +256,7 @@ TEST(DesignCli, ValidProfileFileWorks) {
   test::TempDir dir;
   const auto file = dir / "custom.toml";
   test::write_file(file, valid_lens_profile);
-  const auto r = run_nelf("design --json --profile " + shell_quote(file.string()));
+  const auto r = run_nelf("design --json --profile " + q(file));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(parse_one_object(r.out)["resolution_px"], nlohmann::json::array({146, 78}));
 }

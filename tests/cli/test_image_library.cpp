@@ -18,6 +18,7 @@ using test::ScopedEnv;
 using test::files_in;
 using test::run_command;
 using test::run_nelf;
+using test::q;
 using test::shell_quote;
 using test::TempDir;
 
@@ -31,11 +32,10 @@ TEST(ImageLibrary, TheNelfBinaryDoesNotLinkOpenImageIO) {
 TEST(ImageLibrary, VideoConversionAndProbeRunWithoutIt) {
   TempDir dir;
   const ScopedEnv no_module("NELF_IMAGE_LIBRARY", (dir / "no-such-module.so").string());
-  const auto converted =
-      run_nelf("convert synthetic:duration=0.25,size=160x90 " + shell_quote((dir / "out.mkv").string()) +
-               " --profile " + shell_quote(test::write_small_profile(dir).string()) + " --quiet");
+  const auto converted = run_nelf("convert synthetic:duration=0.25,size=160x90 " + q(dir / "out.mkv") + " --profile " +
+                                  q(test::write_small_profile(dir)) + " --quiet");
   EXPECT_EQ(converted.status, 0) << converted.err;
-  const auto probed = run_nelf("probe " + shell_quote((dir / "out.mkv").string()));
+  const auto probed = run_nelf("probe " + q(dir / "out.mkv"));
   EXPECT_EQ(probed.status, 0) << probed.err;
 }
 
@@ -46,10 +46,7 @@ TEST(ImageLibrary, AMissingModuleIsOneClearLineAndNoOutput) {
   const auto profile = test::write_small_profile(dir);
   const ScopedEnv no_module("NELF_IMAGE_LIBRARY", (dir / "no-such-module.so").string());
   test::expect_clean_failure(
-      dir,
-      "convert " + shell_quote(input.string()) + " " + shell_quote((dir / "out.png").string()) + " --profile " +
-          shell_quote(profile.string()),
-      1,
+      dir, "convert " + q(input) + " " + q(dir / "out.png") + " --profile " + q(profile), 1,
       "cannot load nelf's image library " + (dir / "no-such-module.so").string() + ": cannot open shared object file");
 }
 
@@ -64,10 +61,8 @@ TEST(ImageLibrary, AModuleFromSomethingElseIsRefused) {
   std::string path = libm.out.substr(0, libm.out.find('\n'));
   if (path.empty()) GTEST_SKIP() << "no libm.so.6 in ldconfig's cache";
   const ScopedEnv other("NELF_IMAGE_LIBRARY", path);
-  test::expect_clean_failure(dir,
-                             "convert " + shell_quote(input.string()) + " " + shell_quote((dir / "out.png").string()) +
-                                 " --profile " + shell_quote(profile.string()),
-                             1, "is not the image library of this nelf build");
+  test::expect_clean_failure(dir, "convert " + q(input) + " " + q(dir / "out.png") + " --profile " + q(profile), 1,
+                             "is not the image library of this nelf build");
 }
 
 }  // namespace

@@ -110,8 +110,7 @@ class PipeWireCliTest : public ::testing::Test {
         "gst-launch-1.0 -q videotestsrc num-buffers=1 pattern=smpte ! video/x-raw,format=BGRx,width={},height={} ! "
         "videoconvert ! video/x-raw,format=RGB ! filesink location={} && ffmpeg -v error -f rawvideo -pix_fmt rgb24 "
         "-s {}x{} -i {} -y {}",
-        width, height, test::shell_quote(raw.string()), width, height, test::shell_quote(raw.string()),
-        test::shell_quote(png.string())));
+        width, height, test::q(raw), width, height, test::q(raw), test::q(png)));
     EXPECT_EQ(made.status, 0) << made.err;
     std::filesystem::remove(raw);
     return png;
@@ -121,10 +120,7 @@ class PipeWireCliTest : public ::testing::Test {
   void convert_bars_still(test::ReadBack& expected) {
     const auto still = bars_still();
     const auto reference = dir_ / "reference.png";
-    ASSERT_EQ(
-        test::run_nelf("convert " + test::shell_quote(still.string()) + " " + test::shell_quote(reference.string()))
-            .status,
-        0);
+    ASSERT_EQ(test::run_nelf("convert " + test::q(still) + " " + test::q(reference)).status, 0);
     expected = test::read_back(reference);
   }
 
@@ -144,8 +140,7 @@ TEST_F(PipeWireCliTest, ANodesFramesAreWhatTheSameStillWouldShow) {
     const std::string name = "bars-" + format;
     start_node(name, format);
     const auto out = dir_ / (name + ".png");
-    const auto r =
-        test::run_nelf("convert pipewire:node=" + name + " " + test::shell_quote(out.string()) + " --frames 1");
+    const auto r = test::run_nelf("convert pipewire:node=" + name + " " + test::q(out) + " --frames 1");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find("\"" + name + "\" (Video/Source), 640x180, live, two 320x180 views, layout sbs (aspect)"),
               std::string::npos)
@@ -162,7 +157,7 @@ TEST_F(PipeWireCliTest, YuvNodesAreWhatFfmpegMakesOfTheSameFrame) {
   // converts the same raw frame, so the recording is nelf's conversion of ffmpeg's picture of it.
   // I420 (one plane a spa_data, as GStreamer sends it) and YUY2 (packed); the other formats and
   // layouts in tests/inputs/test_pipewire_frame.cpp.
-  const std::string small = " --signal sbs --profile " + test::shell_quote(test::write_small_profile(dir_).string());
+  const std::string small = " --signal sbs --profile " + test::q(test::write_small_profile(dir_));
   for (const auto& [format, ffmpeg_format] : {std::pair{"I420", "yuv420p"}, {"YUY2", "yuyv422"}}) {
     SCOPED_TRACE(format);
     const auto raw = dir_ / "bars.yuv", picture = dir_ / "bars.png", reference = dir_ / "reference.png";
@@ -170,18 +165,13 @@ TEST_F(PipeWireCliTest, YuvNodesAreWhatFfmpegMakesOfTheSameFrame) {
         "gst-launch-1.0 -q videotestsrc num-buffers=1 pattern=smpte ! video/x-raw,format={},width=640,height=180 ! "
         "filesink location={} && ffmpeg -v error -f rawvideo -pix_fmt {} -s 640x180 -i {} "
         "-sws_flags bicubic+accurate_rnd+full_chroma_int -pix_fmt rgb24 -y {}",
-        format, test::shell_quote(raw.string()), ffmpeg_format, test::shell_quote(raw.string()),
-        test::shell_quote(picture.string())));
+        format, test::q(raw), ffmpeg_format, test::q(raw), test::q(picture)));
     ASSERT_EQ(made.status, 0) << made.err;
-    ASSERT_EQ(test::run_nelf("convert " + test::shell_quote(picture.string()) + " -y " +
-                             test::shell_quote(reference.string()) + small)
-                  .status,
-              0);
+    ASSERT_EQ(test::run_nelf("convert " + test::q(picture) + " -y " + test::q(reference) + small).status, 0);
     const std::string name = std::string("yuv-") + format;
     start_node(name, format);
     const auto out = dir_ / (name + ".png");
-    const auto r =
-        test::run_nelf("convert pipewire:node=" + name + " " + test::shell_quote(out.string()) + " --frames 1" + small);
+    const auto r = test::run_nelf("convert pipewire:node=" + name + " " + test::q(out) + " --frames 1" + small);
     ASSERT_EQ(r.status, 0) << r.err;
     const auto got = test::read_back(out), expected = test::read_back(reference);
     ASSERT_EQ(got.width, expected.width);
@@ -194,9 +184,8 @@ TEST_F(PipeWireCliTest, ARecordingEndsCompleteWhenTheNodeGoesAway) {
   // As a game's window closing ends `x11:window=`: the producer quits, nelf finishes the file.
   start_node("leaving", "BGRx");
   const auto out = dir_ / "recording.mkv";
-  auto recording = std::async(std::launch::async, [&] {
-    return test::run_nelf("convert pipewire:node=leaving " + test::shell_quote(out.string()));
-  });
+  auto recording =
+      std::async(std::launch::async, [&] { return test::run_nelf("convert pipewire:node=leaving " + test::q(out)); });
   std::this_thread::sleep_for(3s);
   nodes_.back()->stop();
   ASSERT_EQ(recording.wait_for(20s), std::future_status::ready) << "nelf went on after the node was gone";
@@ -205,7 +194,7 @@ TEST_F(PipeWireCliTest, ARecordingEndsCompleteWhenTheNodeGoesAway) {
   const auto probed = test::run_command(
       "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
       "stream=width,height,nb_read_frames -of csv=p=0 " +
-      test::shell_quote(out.string()));
+      test::q(out));
   ASSERT_EQ(probed.status, 0) << probed.err;
   int width = 0, height = 0, frames = 0;
   ASSERT_EQ(std::sscanf(probed.out.c_str(), "%d,%d,%d", &width, &height, &frames), 3) << probed.out;
@@ -328,7 +317,7 @@ TEST_F(PortalCliTest, TheUserIsAskedOnceAndTheChoiceIsKept) {
   ASSERT_NO_FATAL_FAILURE(convert_bars_still(expected));
   next_screen();
   const auto out = dir_ / "cast.png";
-  auto r = test::run_nelf("convert pipewire: " + test::shell_quote(out.string()) + " --frames 1");
+  auto r = test::run_nelf("convert pipewire: " + test::q(out) + " --frames 1");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("the desktop's screen cast of a monitor (PipeWire node "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("640x180, live, two 320x180 views, layout sbs (aspect)"), std::string::npos) << r.err;
@@ -340,12 +329,12 @@ TEST_F(PortalCliTest, TheUserIsAskedOnceAndTheChoiceIsKept) {
   EXPECT_TRUE(std::filesystem::exists(state_ / "nelf" / "screencast-restore-token"));
 
   next_screen();
-  r = test::run_nelf("convert pipewire: " + test::shell_quote((dir_ / "again.png").string()) + " --frames 1");
+  r = test::run_nelf("convert pipewire: " + test::q(dir_ / "again.png") + " --frames 1");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(backend_log(), "asked started closed restored started closed ") << "the kept choice was not restored";
 
   next_screen();
-  r = test::run_nelf("convert pipewire:restore=no " + test::shell_quote((dir_ / "ask.png").string()) + " --frames 1");
+  r = test::run_nelf("convert pipewire:restore=no " + test::q(dir_ / "ask.png") + " --frames 1");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(backend_log(), "asked started closed restored started closed asked started closed ");
 }
@@ -381,7 +370,7 @@ TEST_F(PortalCliTest, CtrlCWhileTheDialogIsOpenEndsCleanly) {
   start_backend("never");
   next_screen();
   const auto out = dir_ / "out.mkv";
-  const auto r = test::run_command(std::string(NELF_BINARY) + " convert pipewire: " + test::shell_quote(out.string()) +
+  const auto r = test::run_command(std::string(NELF_BINARY) + " convert pipewire: " + test::q(out) +
                                    " & pid=$!; sleep 2; kill -INT $pid; (sleep 20; kill -KILL $pid) 2>/dev/null & "
                                    "guard=$!; wait $pid; status=$?; kill $guard 2>/dev/null; exit $status");
   EXPECT_EQ(r.status, 130) << r.err;

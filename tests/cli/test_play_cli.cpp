@@ -25,19 +25,8 @@ namespace {
 
 // Side by side at `fps` for `seconds`: left red-ish, right blue-ish, a moving white box, and a
 // 440 Hz tone unless `audio` is false.
-std::filesystem::path make_clip(const TempDir& dir, const std::string& name, double seconds, int fps,
-                                bool audio = true) {
-  const std::string d = std::to_string(seconds), r = std::to_string(fps);
-  std::string args = "-f lavfi -i color=c=0xC03020:s=320x180:r=" + r + ":d=" + d +
-                     " -f lavfi -i color=c=0x2040C0:s=320x180:r=" + r + ":d=" + d +
-                     " -f lavfi -i color=c=white:s=20x60:r=" + r + ":d=" + d;
-  if (audio) args += " -f lavfi -i sine=f=440:r=48000:d=" + d;
-  args +=
-      " -filter_complex \"[2]split[b1][b2];[0][b1]overlay=x='mod(n*5,300)':y=60[l];"
-      "[1][b2]overlay=x='mod(n*5,300)':y=60[r];[l][r]hstack\"" +
-      h264;
-  if (audio) args += " -c:a aac -shortest";
-  return make_media(dir / name, args);
+std::filesystem::path make_clip(const TempDir& dir, const std::string& name, int seconds, int fps, bool audio = true) {
+  return make_moving_box_clip(dir / name, seconds, fps, audio);
 }
 
 class PlayCli : public ::testing::Test {

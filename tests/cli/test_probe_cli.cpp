@@ -12,7 +12,7 @@ namespace nelf::test {
 namespace {
 
 nlohmann::json probe_json(const std::filesystem::path& path, const std::string& extra = "") {
-  const CommandResult r = run_nelf("probe --json " + shell_quote(path.string()) + " " + extra);
+  const CommandResult r = run_nelf("probe --json " + q(path) + " " + extra);
   EXPECT_EQ(r.status, 0) << r.err;
   return nlohmann::json::parse(r.out);  // exactly one object: parse fails on anything else
 }
@@ -122,7 +122,7 @@ TEST(ProbeCli, ReleaseNameSbsIsHalfOrFullByTheFrame) {
   EXPECT_EQ(probe_json(clip("Movie.1080p.3D.Full-SBS.mkv", "320x180"))["layout"], "sbs");
   EXPECT_EQ(probe_json(clip("Movie.1080p.3D.OU.mkv", "320x180"))["layout"], "tab-half");
   // The table says the same, with the rule.
-  const CommandResult r = run_nelf("probe " + shell_quote((dir / "Movie.1080p.3D.SBS.mkv").string()));
+  const CommandResult r = run_nelf("probe " + q(dir / "Movie.1080p.3D.SBS.mkv"));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("sbs-half (rule: filename)"), std::string::npos) << r.out;
 }
@@ -140,7 +140,7 @@ TEST(ProbeCli, FilenameAspectAndDefault) {
   EXPECT_EQ(by_aspect["rule"], "aspect");
 
   const auto flat = make_media(dir / "flat.mkv", plain);
-  const CommandResult r = run_nelf("probe --json " + shell_quote(flat.string()));
+  const CommandResult r = run_nelf("probe --json " + q(flat));
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json fallback = nlohmann::json::parse(r.out);
   EXPECT_EQ(fallback["layout"], "mono");
@@ -156,7 +156,7 @@ TEST(ProbeCli, FlagOverridesMetadata) {
   EXPECT_EQ(j["layout"], "tab");
   EXPECT_EQ(j["swap_eyes"], true);
   EXPECT_EQ(j["rule"], "flag");
-  const CommandResult bad = run_nelf("probe --layout diagonal " + shell_quote(path.string()));
+  const CommandResult bad = run_nelf("probe --layout diagonal " + q(path));
   EXPECT_EQ(bad.status, 2);
 }
 
@@ -165,7 +165,7 @@ TEST(ProbeCli, SummaryIsReadable) {
   const auto path = make_media(dir / "clip.mkv",
                                "-f lavfi -i testsrc2=s=160x180:r=25 -frames:v 2 -vf setsar=2/1 "
                                "-c:v ffv1 -metadata:s:v:0 stereo_mode=left_right");
-  const CommandResult r = run_nelf("probe " + shell_quote(path.string()));
+  const CommandResult r = run_nelf("probe " + q(path));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("ffv1 160x180"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("SAR 2:1"), std::string::npos) << r.out;
@@ -177,8 +177,7 @@ TEST(ProbeCli, SummaryIsReadable) {
 TEST(ProbeCli, RotatedPhoneVideoReportsUprightSize) {
   TempDir dir;
   const auto stored = make_media(dir / "stored.mp4", "-f lavfi -i testsrc2=s=64x36:r=10 -frames:v 2 -c:v libx264");
-  const auto rotated =
-      make_media(dir / "rotated.mp4", "-i " + shell_quote(stored.string()) + " -c copy -metadata:s:v:0 rotate=90");
+  const auto rotated = make_media(dir / "rotated.mp4", "-i " + q(stored) + " -c copy -metadata:s:v:0 rotate=90");
   const nlohmann::json j = probe_json(rotated);
   EXPECT_EQ(j["width"], 36);
   EXPECT_EQ(j["height"], 64);
@@ -188,11 +187,10 @@ TEST(ProbeCli, RotatedPhoneVideoReportsUprightSize) {
 TEST(ProbeCli, BadInputFailsWithOneLine) {
   TempDir dir;
   write_file(dir / "notes.txt", "hello, not a video\n");
-  expect_clean_failure(run_nelf("probe " + shell_quote((dir / "notes.txt").string())), "notes.txt", "not a media file");
-  expect_clean_failure(run_nelf("probe --json " + shell_quote((dir / "absent.mkv").string())), "absent.mkv",
-                       "no such file");
+  expect_clean_failure(run_nelf("probe " + q(dir / "notes.txt")), "notes.txt", "not a media file");
+  expect_clean_failure(run_nelf("probe --json " + q(dir / "absent.mkv")), "absent.mkv", "no such file");
   const auto song = make_media(dir / "song.mka", "-f lavfi -i sine=duration=0.2 -c:a flac");
-  expect_clean_failure(run_nelf("probe " + shell_quote(song.string())), "song.mka", "no video stream");
+  expect_clean_failure(run_nelf("probe " + q(song)), "song.mka", "no video stream");
   expect_clean_failure(run_nelf("probe http://127.0.0.1:9/film.mkv"), "http://127.0.0.1:9/film.mkv", "--allow-network");
 }
 
@@ -206,7 +204,7 @@ TEST(ProbeCli, TruncatedFileStillProbes) {
   EXPECT_EQ(j["layout"], "sbs-half");
   // Cut before its first frame there is nothing to show: a clean error.
   write_file(dir / "truncated.mkv", bytes.substr(0, 200));
-  const CommandResult r = run_nelf("probe " + shell_quote((dir / "truncated.mkv").string()));
+  const CommandResult r = run_nelf("probe " + q(dir / "truncated.mkv"));
   EXPECT_NE(r.status, 0);
   EXPECT_LT(r.status, 128);
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

@@ -69,8 +69,7 @@ struct Fixture {
   }
   // `nelf simulate STILL --profile small.toml -o retina.png ARGS`
   CommandResult simulate(const std::string& args) const {
-    return run_nelf("simulate " + shell_quote(still.string()) + " --profile " + shell_quote(profile.string()) + " -o " +
-                    shell_quote(retina.string()) + " " + args);
+    return run_nelf("simulate " + q(still) + " --profile " + q(profile) + " -o " + q(retina) + " " + args);
   }
   double psnr(const std::string& args) const {
     const CommandResult r = simulate("--json " + args);
@@ -96,7 +95,7 @@ std::array<int, 2> image_size(const std::filesystem::path& path) {
 
 TEST(SimulateCli, JsonSchemaAndRetinalImage) {
   Fixture f;
-  const CommandResult r = f.simulate("--json --ideal " + shell_quote((f.dir / "ideal.png").string()));
+  const CommandResult r = f.simulate("--json --ideal " + q(f.dir / "ideal.png"));
   ASSERT_EQ(r.status, 0) << r.err;
   ASSERT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << "exactly one line of JSON: " << r.out;
   const auto j = nlohmann::json::parse(r.out);
@@ -184,7 +183,7 @@ std::map<std::pair<std::string, std::string>, std::map<std::string, std::string>
 TEST(SimulateCli, SweepWritesTableAndHeatmap) {
   Fixture f;
   const auto csv = f.dir / "sweep.csv";
-  const CommandResult r = f.simulate("--json --sweep " + shell_quote(csv.string()));
+  const CommandResult r = f.simulate("--json --sweep " + q(csv));
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string table = read_file(csv);
   EXPECT_EQ(table.rfind("screen_diopters,screen_mm,accommodation_diopters,accommodation_mm,psnr_db", 0), 0u);
@@ -222,12 +221,12 @@ TEST(SimulateCli, SweepWritesTableAndHeatmap) {
 // table and in a heatmap of its own. The flat cells are the --depth off sweep's.
 TEST(SimulateCli, SweepAgainstTheRealSceneShowsTheDepthAwareGain) {
   Fixture f;
-  const std::string planes = "simulate synthetic:scene=planes,size=320x180 --profile " +
-                             shell_quote(f.profile.string()) + " -o " + shell_quote(f.retina.string());
+  const std::string planes =
+      "simulate synthetic:scene=planes,size=320x180 --profile " + q(f.profile) + " -o " + q(f.retina);
   const auto depth_csv = f.dir / "depth.csv", flat_csv = f.dir / "flat.csv";
-  CommandResult r = run_nelf(planes + " --depth auto --sweep " + shell_quote(depth_csv.string()));
+  CommandResult r = run_nelf(planes + " --depth auto --sweep " + q(depth_csv));
   ASSERT_EQ(r.status, 0) << r.err;
-  r = run_nelf(planes + " --depth off --sweep " + shell_quote(flat_csv.string()));
+  r = run_nelf(planes + " --depth off --sweep " + q(flat_csv));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto with_depth = sweep_cells(read_file(depth_csv)), flat = sweep_cells(read_file(flat_csv));
   ASSERT_EQ(with_depth.size(), 9u * 17u);
@@ -252,7 +251,7 @@ TEST(SimulateCli, SweepAgainstTheRealSceneShowsTheDepthAwareGain) {
 TEST(SimulateCli, SweepShowsThePanelsDefects) {
   const auto psnr_at_the_screen = [](const Fixture& f, const std::string& args) {
     const auto csv = f.dir / "sweep.csv";
-    const CommandResult r = f.simulate("--sweep " + shell_quote(csv.string()) + " " + args);
+    const CommandResult r = f.simulate("--sweep " + q(csv) + " " + args);
     EXPECT_EQ(r.status, 0) << r.err;
     const std::string table = read_file(csv);
     const std::string row = "\n1,1000.0,1,1000.0,";  // the 1 m screen, the eye focused on it
@@ -316,15 +315,13 @@ TEST(SimulateCli, BadFocusAndPupil) {
 TEST(SimulateCli, UnwritableOutput) {
   Fixture f;
   const auto missing_dir = f.dir / "no-such-dir" / "retina.png";
-  CommandResult r = run_nelf("simulate " + shell_quote(f.still.string()) + " --profile " +
-                             shell_quote(f.profile.string()) + " -o " + shell_quote(missing_dir.string()));
+  CommandResult r = run_nelf("simulate " + q(f.still) + " --profile " + q(f.profile) + " -o " + q(missing_dir));
   expect_one_line_error(r, "cannot write --output");
-  r = f.simulate("--ideal " + shell_quote(f.dir.path().string()));  // a directory
+  r = f.simulate("--ideal " + q(f.dir.path()));  // a directory
   expect_one_line_error(r, "cannot write --ideal");
   EXPECT_FALSE(std::filesystem::exists(f.retina));
   // An extension no image format claims: refused up front, nothing written.
-  r = run_nelf("simulate " + shell_quote(f.still.string()) + " --profile " + shell_quote(f.profile.string()) + " -o " +
-               shell_quote((f.dir / "retina.nosuchformat").string()));
+  r = run_nelf("simulate " + q(f.still) + " --profile " + q(f.profile) + " -o " + q(f.dir / "retina.nosuchformat"));
   expect_one_line_error(r, "unknown image extension");
   int files = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(f.dir.path())) ++files;
@@ -337,11 +334,10 @@ TEST(SimulateCli, UnwritableOutput) {
 TEST(SimulateCli, OutputOntoTheInputIsRefused) {
   Fixture f;
   const std::string bytes = read_file(f.still);
-  const std::string still = shell_quote(f.still.string());
-  const std::string head = "simulate " + still + " --profile " + shell_quote(f.profile.string());
-  for (const std::string& args :
-       {" -o " + still, " -o " + shell_quote(f.retina.string()) + " --ideal " + still,
-        " -o " + shell_quote(f.retina.string()) + " --sweep " + shell_quote((f.dir / "still.csv").string())}) {
+  const std::string still = q(f.still);
+  const std::string head = "simulate " + still + " --profile " + q(f.profile);
+  for (const std::string& args : {" -o " + still, " -o " + q(f.retina) + " --ideal " + still,
+                                  " -o " + q(f.retina) + " --sweep " + q(f.dir / "still.csv")}) {
     SCOPED_TRACE(args);
     expect_clean_failure(f.dir, head + args, 2, "the output is the same file as the input");
     EXPECT_EQ(read_file(f.still), bytes);
@@ -350,17 +346,15 @@ TEST(SimulateCli, OutputOntoTheInputIsRefused) {
   const auto named_like_the_gain = f.dir / "sweep.gain.png";
   std::filesystem::copy_file(f.still, named_like_the_gain);
   expect_clean_failure(f.dir,
-                       "simulate " + shell_quote(named_like_the_gain.string()) + " --profile " +
-                           shell_quote(f.profile.string()) + " -o " + shell_quote(f.retina.string()) +
-                           " --depth estimate --sweep " + shell_quote((f.dir / "sweep.csv").string()),
+                       "simulate " + q(named_like_the_gain) + " --profile " + q(f.profile) + " -o " + q(f.retina) +
+                           " --depth estimate --sweep " + q(f.dir / "sweep.csv"),
                        2, "the output is the same file as the input");
   EXPECT_EQ(read_file(named_like_the_gain), bytes);
 }
 
 TEST(SimulateCli, StockProfileIsRejected) {
   Fixture f;
-  const CommandResult r = run_nelf("simulate " + shell_quote(f.still.string()) + " --profile hmz-t1-stock -o " +
-                                   shell_quote(f.retina.string()));
+  const CommandResult r = run_nelf("simulate " + q(f.still) + " --profile hmz-t1-stock -o " + q(f.retina));
   expect_one_line_error(r, "lens_array");
   EXPECT_FALSE(std::filesystem::exists(f.retina));
 }

@@ -18,8 +18,8 @@ struct PlanesRun {
 };
 
 PlanesRun simulate_planes(const TempDir& dir, const std::string& args) {
-  const CommandResult r = run_nelf("simulate synthetic:scene=planes --profile hmz-t1 -o " +
-                                   shell_quote((dir / "retina.png").string()) + " --json " + args);
+  const CommandResult r =
+      run_nelf("simulate synthetic:scene=planes --profile hmz-t1 -o " + q(dir / "retina.png") + " --json " + args);
   EXPECT_EQ(r.status, 0) << r.err;
   PlanesRun run;
   if (r.status != 0) return run;
@@ -56,31 +56,29 @@ TEST(SimulateDepthCli, FocusFollowsEachPlanesDepth) {
   // 3.87 D for 4 D, far 0.85 D for 1 D); flat, both are sharpest at the screen (near 0.81 D).
   TempDir dir;
   const auto csv = dir / "focus.csv";
-  const PlanesRun exact = simulate_planes(dir, "--depth auto --focus-sweep " + shell_quote(csv.string()));
+  const PlanesRun exact = simulate_planes(dir, "--depth auto --focus-sweep " + q(csv));
   EXPECT_NEAR(exact.best_focus_diopters.at("near"), 4.0, 0.25);
   EXPECT_NEAR(exact.best_focus_diopters.at("far"), 1.0, 0.25);
   const std::string table = read_file(csv);
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 1 + 2 * 19) << table;  // 2 regions × 19 accommodations
   EXPECT_TRUE(std::filesystem::exists(dir / "focus.png"));
-  const PlanesRun flat = simulate_planes(dir, "--depth off --focus-sweep " + shell_quote(csv.string()));
+  const PlanesRun flat = simulate_planes(dir, "--depth off --focus-sweep " + q(csv));
   EXPECT_NEAR(flat.best_focus_diopters.at("near"), 1.0, 0.3);
 }
 
 TEST(SimulateDepthCli, AStillHasNoSceneToCompareWith) {
   TempDir dir;
   const auto still = write_lavfi_still(dir, "still.png", "testsrc2=s=512x144");
-  expect_clean_failure(dir,
-                       "simulate " + shell_quote(still.string()) + " --layout sbs --reference scene -o " +
-                           shell_quote((dir / "retina.png").string()),
-                       2, "--reference scene needs an input that knows its depth");
+  expect_clean_failure(dir, "simulate " + q(still) + " --layout sbs --reference scene -o " + q(dir / "retina.png"), 2,
+                       "--reference scene needs an input that knows its depth");
 }
 
 TEST(SimulateDepthCli, ABlackPairCannotBeMatchedAndFallsBackToTheScreen) {
   // No texture, no disparity: the flat screen, said once, never garbage.
   TempDir dir;
   const auto still = write_lavfi_still(dir, "black.png", "color=black:s=512x144");
-  const CommandResult r = run_nelf("simulate " + shell_quote(still.string()) + " --layout sbs --depth estimate -o " +
-                                   shell_quote((dir / "retina.png").string()));
+  const CommandResult r =
+      run_nelf("simulate " + q(still) + " --layout sbs --depth estimate -o " + q(dir / "retina.png"));
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find("cannot be matched"), std::string::npos) << r.err;
@@ -89,7 +87,7 @@ TEST(SimulateDepthCli, ABlackPairCannotBeMatchedAndFallsBackToTheScreen) {
 
 TEST(SimulateDepthCli, BadSyntheticOptions) {
   TempDir dir;
-  const std::string out = " -o " + shell_quote((dir / "retina.png").string());
+  const std::string out = " -o " + q(dir / "retina.png");
   expect_clean_failure(dir, "simulate synthetic:scene=cubes" + out, 2, "scene must be spheres or planes");
   expect_clean_failure(dir, "simulate synthetic:scene=planes,near=2000" + out, 2, "must be nearer than the far one");
 }

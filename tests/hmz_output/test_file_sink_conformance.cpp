@@ -25,7 +25,7 @@ namespace {
 
 using test::files_in;
 using test::run_command;
-using test::shell_quote;
+using test::q;
 using test::TempDir;
 
 constexpr int kWidth = 64, kHeight = 32;  // even: 4:2:0 encoders take it
@@ -78,7 +78,7 @@ long video_frames(const std::filesystem::path& file) {
   const auto r = run_command(
       "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
       "stream=nb_read_frames,width,height -of csv=p=0 " +
-      shell_quote(file.string()));
+      q(file));
   int width = 0, height = 0;
   long frames = -1;
   if (std::sscanf(r.out.c_str(), "%d,%d,%ld", &width, &height, &frames) != 3) return -1;

@@ -9,7 +9,7 @@ namespace nelf {
 namespace {
 
 using test::run_command;
-using test::shell_quote;
+using test::q;
 using test::TempDir;
 
 // A frame whose top half is red and bottom half is blue, with a black band in the middle rows.
@@ -30,7 +30,7 @@ PackedFrame test_frame(int width, int height, double pts, int black_from, int bl
 
 std::string probe(const std::filesystem::path& file, const std::string& entries) {
   return run_command("ffprobe -v error -select_streams v:0 -count_frames -show_entries stream=" + entries +
-                     " -of default=nw=1:nk=1 " + shell_quote(file.string()))
+                     " -of default=nw=1:nk=1 " + q(file))
       .out;
 }
 
@@ -77,10 +77,7 @@ TEST(VideoEncoder, LosslessCodecsKeepRgbExactly) {
     enc.write_video(frame);
     enc.finish();
     const auto raw = dir / "raw.rgba";
-    ASSERT_EQ(run_command("ffmpeg -v error -i " + shell_quote(out.string()) + " -f rawvideo -pix_fmt rgba " +
-                          shell_quote(raw.string()))
-                  .status,
-              0);
+    ASSERT_EQ(run_command("ffmpeg -v error -i " + q(out) + " -f rawvideo -pix_fmt rgba " + q(raw)).status, 0);
     const std::string bytes = test::read_file(raw);
     ASSERT_EQ(bytes.size(), frame.rgba.size());
     EXPECT_TRUE(std::equal(bytes.begin(), bytes.end(), frame.rgba.begin(),
@@ -172,7 +169,7 @@ TEST(VideoEncoder, CarriesAudioSubtitlesAndChapters) {
   const auto source_path = dir / "source.mkv";
   test::write_file(dir / "subs.srt", "1\n00:00:00,000 --> 00:00:00,500\nhello\n");
   test::write_file(dir / "chapters.txt", ";FFMETADATA1\n[CHAPTER]\nTIMEBASE=1/1000\nSTART=0\nEND=500\ntitle=One\n");
-  ASSERT_EQ(test::run_command("cd " + test::shell_quote(dir.path().string()) +
+  ASSERT_EQ(test::run_command("cd " + test::q(dir.path()) +
                               " && ffmpeg -v error -f lavfi -i testsrc2=size=64x36:rate=10 -f lavfi -i "
                               "sine=frequency=440:sample_rate=48000 -i subs.srt -i chapters.txt -map 0:v -map 1:a "
                               "-map 2:s -map_chapters 3 -t 1 -c:v libx264 -c:a flac -c:s srt "
@@ -203,7 +200,7 @@ TEST(VideoEncoder, CarriesAudioSubtitlesAndChapters) {
   const auto streams = test::run_command(
       "ffprobe -v error -show_entries stream=codec_type,codec_name:stream_tags=language "
       "-show_chapters -of csv=p=0 " +
-      test::shell_quote(out.string()));
+      test::q(out));
   EXPECT_NE(streams.out.find("h264,video"), std::string::npos) << streams.out;
   EXPECT_NE(streams.out.find("flac,audio,fra"), std::string::npos) << streams.out;
   EXPECT_NE(streams.out.find("subrip,subtitle"), std::string::npos) << streams.out;
@@ -212,7 +209,7 @@ TEST(VideoEncoder, CarriesAudioSubtitlesAndChapters) {
   const auto packets = test::run_command(
       "ffprobe -v error -select_streams a:0 -show_entries packet=pts_time,duration_time "
       "-of csv=p=0 " +
-      test::shell_quote(out.string()));
+      test::q(out));
   const auto last_line = packets.out.substr(packets.out.rfind('\n', packets.out.size() - 2) + 1);
   const double audio_end = std::atof(last_line.c_str()) + std::atof(last_line.substr(last_line.find(',') + 1).c_str());
   EXPECT_NEAR(audio_end, 1.0, 0.1) << packets.out;
@@ -236,9 +233,8 @@ TEST(VideoEncoder, GeneratedAudioTrackIsAac) {
     enc.write_audio(second.data() + i * 1920, 1920);
   }
   enc.finish();
-  const auto r =
-      test::run_command("ffprobe -v error -show_entries stream=codec_name,sample_rate,channels -of csv=p=0 " +
-                        test::shell_quote(out.string()));
+  const auto r = test::run_command(
+      "ffprobe -v error -show_entries stream=codec_name,sample_rate,channels -of csv=p=0 " + test::q(out));
   EXPECT_NE(r.out.find("aac,48000,1"), std::string::npos) << r.out;
 }
 
@@ -248,7 +244,7 @@ TEST(VideoEncoder, ReencodesAudioTheContainerCannotHold) {
   const auto source_path = dir / "pcm.mkv";
   ASSERT_EQ(test::run_command("ffmpeg -v error -f lavfi -i testsrc2=size=64x36:rate=10 -f lavfi -i "
                               "sine=frequency=440:sample_rate=44100 -t 1 -c:v libx264 -c:a pcm_s16le " +
-                              test::shell_quote(source_path.string()))
+                              test::q(source_path))
                 .status,
             0);
   AVFormatContext* raw = nullptr;
@@ -269,8 +265,8 @@ TEST(VideoEncoder, ReencodesAudioTheContainerCannotHold) {
   }
   av_packet_free(&packet);
   enc.finish();
-  const auto r = test::run_command("ffprobe -v error -show_entries stream=codec_name,sample_rate -of csv=p=0 " +
-                                   test::shell_quote(out.string()));
+  const auto r =
+      test::run_command("ffprobe -v error -show_entries stream=codec_name,sample_rate -of csv=p=0 " + test::q(out));
   EXPECT_NE(r.out.find("aac,44100"), std::string::npos) << r.out;
 }
 

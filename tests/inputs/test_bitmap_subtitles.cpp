@@ -77,7 +77,7 @@ TEST(BitmapSubtitles, DvbAndVobSubMadeByTheFfmpegCliLandWherePgsDoes) {
     SCOPED_TRACE(codec);
     const std::filesystem::path mkv = dir / (std::string(codec) + ".mkv");
     // PGS says no end of its own: -fix_sub_duration gives each picture its time until the next.
-    test::make_media(mkv, "-fix_sub_duration -copyts -i " + test::shell_quote(sup.string()) + " -c:s " + codec);
+    test::make_media(mkv, "-fix_sub_duration -copyts -i " + test::q(sup) + " -c:s " + codec);
     SubtitleTrack track(mkv.string(), 0.0);
     EXPECT_TRUE(track.render(0.2, 320, 180, 0.0).empty());
     expect_box(covered(track.render(1.0, 320, 180, 0.0).rgba, 320), 120, 150, 199, 164);

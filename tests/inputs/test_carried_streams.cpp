@@ -19,7 +19,7 @@ namespace nelf {
 namespace {
 
 using test::make_media;
-using test::shell_quote;
+using test::q;
 using test::TempDir;
 
 // One packet as read: enough to tell two apart.
@@ -68,13 +68,13 @@ std::filesystem::path make_clip(const TempDir& dir, const std::string& name, con
                    "1\n00:00:00,000 --> 00:00:00,500\nhello\n\n2\n00:00:00,600 --> 00:00:00,900\nbye\n");
   test::write_file(dir / "chapters.txt",
                    ";FFMETADATA1\ntitle=Clip\n[CHAPTER]\nTIMEBASE=1/1000\nSTART=0\nEND=500\ntitle=One\n");
-  return make_media(
-      dir / name, "-f lavfi -i testsrc2=size=64x36:rate=10 -f lavfi -i sine=frequency=440:sample_rate=48000 -i " +
-                      shell_quote((dir / "subs.srt").string()) + " -i " + shell_quote((dir / "chapters.txt").string()) +
-                      " -map 0:v -map 1:a " + (subtitles ? "-map 2:s " : "") +
-                      "-map_metadata 3 -map_chapters 3 -t 1 -c:v libx264 -preset ultrafast "
-                      "-metadata:s:a:0 language=fra " +
-                      codecs);
+  return make_media(dir / name,
+                    "-f lavfi -i testsrc2=size=64x36:rate=10 -f lavfi -i sine=frequency=440:sample_rate=48000 -i " +
+                        q(dir / "subs.srt") + " -i " + q(dir / "chapters.txt") + " -map 0:v -map 1:a " +
+                        (subtitles ? "-map 2:s " : "") +
+                        "-map_metadata 3 -map_chapters 3 -t 1 -c:v libx264 -preset ultrafast "
+                        "-metadata:s:a:0 language=fra " +
+                        codecs);
 }
 
 std::string tag(const AVDictionary* dictionary, const char* key) {

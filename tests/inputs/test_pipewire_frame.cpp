@@ -87,9 +87,9 @@ struct I420 {
 std::vector<std::uint8_t> ffmpeg_rgba(const std::vector<std::uint8_t>& raw, const std::string& pix_fmt) {
   const test::TempDir dir;
   test::write_file(dir / "in.raw", std::string(raw.begin(), raw.end()));
-  const auto r = test::run_command("ffmpeg -v error -f rawvideo -pix_fmt " + pix_fmt + " -s 64x36 -i " +
-                                   test::shell_quote((dir / "in.raw").string()) +
-                                   " -sws_flags bicubic+accurate_rnd+full_chroma_int -f rawvideo -pix_fmt rgba -");
+  const auto r =
+      test::run_command("ffmpeg -v error -f rawvideo -pix_fmt " + pix_fmt + " -s 64x36 -i " + test::q(dir / "in.raw") +
+                        " -sws_flags bicubic+accurate_rnd+full_chroma_int -f rawvideo -pix_fmt rgba -");
   EXPECT_EQ(r.status, 0) << r.err;
   return std::vector<std::uint8_t>(r.out.begin(), r.out.end());
 }

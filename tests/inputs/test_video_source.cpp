@@ -258,11 +258,10 @@ std::vector<std::uint8_t> read_bytes(const std::filesystem::path& path) {
 TEST_F(VideoSourceTest, AppliesRotationLikeFfmpegsAutorotate) {
   const auto stored = make_media(dir / "stored.mp4", quadrants_input() + " -c:v libx264 -pix_fmt yuv444p -qp 0");
   // ffmpeg 5.1 has no -display_rotation; the rotate tag becomes a display matrix on stream copy.
-  const auto rotated = make_media(dir / "rotated.mp4",
-                                  "-i " + test::shell_quote(stored.string()) + " -c copy -metadata:s:v:0 rotate=90");
+  const auto rotated = make_media(dir / "rotated.mp4", "-i " + test::q(stored) + " -c copy -metadata:s:v:0 rotate=90");
   // The reference: what ffmpeg itself shows (autorotate is on by default).
-  const auto reference_path = make_media(
-      dir / "reference.rgba", "-i " + test::shell_quote(rotated.string()) + " -frames:v 1 -f rawvideo -pix_fmt rgba");
+  const auto reference_path =
+      make_media(dir / "reference.rgba", "-i " + test::q(rotated) + " -frames:v 1 -f rawvideo -pix_fmt rgba");
   const std::vector<std::uint8_t> reference = read_bytes(reference_path);
   ASSERT_EQ(reference.size(), 36u * 64u * 4u) << "ffmpeg's autorotated frame should be 36x64";
 
@@ -450,8 +449,7 @@ TEST_F(VideoSourceTest, ReduceRegionsRefusesWhatItCannotCut) {
   EXPECT_FALSE(source.reduce_regions({{1, 0, 64, 72, 4, 4}})) << "off the 4:2:0 chroma grid";
   EXPECT_FALSE(source.reduce_regions({{0, 0, 62, 72, 4, 4}})) << "not whole blocks";
   EXPECT_FALSE(source.reduce_regions({{96, 0, 64, 72, 4, 4}})) << "outside the frame";
-  const auto rotated =
-      make_media(dir / "rotated.mp4", "-i " + test::shell_quote(path.string()) + " -c copy -metadata:s:v:0 rotate=90");
+  const auto rotated = make_media(dir / "rotated.mp4", "-i " + test::q(path) + " -c copy -metadata:s:v:0 rotate=90");
   VideoSource turned(rotated.string());
   ASSERT_TRUE(turned.next_frame());
   EXPECT_FALSE(turned.reduce_regions({{0, 0, 72, 64, 4, 4}})) << "rotated streams come whole";

@@ -15,11 +15,29 @@ inline const std::string h264 = " -c:v libx264 -preset ultrafast -pix_fmt yuv420
 // so that a broken generator shows up as such and not as a decoder bug. lavfi sources are endless:
 // ARGS must bound them (-frames:v, d=, -shortest); the timeout catches a forgotten bound.
 inline std::filesystem::path make_media(const std::filesystem::path& output, const std::string& args) {
-  const CommandResult result = run_command("timeout 60 ffmpeg -nostdin -hide_banner -loglevel error -y " + args + " " +
-                                           shell_quote(output.string()));
+  const CommandResult result =
+      run_command("timeout 60 ffmpeg -nostdin -hide_banner -loglevel error -y " + args + " " + q(output));
   if (result.status != 0 || !std::filesystem::exists(output))
     throw std::runtime_error("ffmpeg could not generate " + output.string() + ": " + result.err);
   return output;
+}
+
+// The players' moving-box clip: a white 20×60 box moving right across a red (left view) and a
+// blue (right view) 320×180 picture, side by side, `seconds` long at `fps`; with `audio`, a 440 Hz
+// tone as an AAC track.
+inline std::filesystem::path make_moving_box_clip(const std::filesystem::path& output, int seconds, int fps,
+                                                  bool audio) {
+  const std::string d = std::to_string(seconds), r = std::to_string(fps);
+  std::string args = "-f lavfi -i color=c=0xC03020:s=320x180:r=" + r + ":d=" + d +
+                     " -f lavfi -i color=c=0x2040C0:s=320x180:r=" + r + ":d=" + d +
+                     " -f lavfi -i color=c=white:s=20x60:r=" + r + ":d=" + d;
+  if (audio) args += " -f lavfi -i sine=f=440:r=48000:d=" + d;
+  args +=
+      " -filter_complex \"[2]split[b1][b2];[0][b1]overlay=x='mod(n*5,300)':y=60[l];"
+      "[1][b2]overlay=x='mod(n*5,300)':y=60[r];[l][r]hstack\"" +
+      h264;
+  if (audio) args += " -c:a aac -shortest";
+  return make_media(output, args);
 }
 
 // Two flat colours side by side (left red, right blue) or stacked (top red, bottom blue), each

@@ -28,15 +28,7 @@ inline Profile small_profile(const TempDir& dir) { return load_profile(write_sma
 // 2 s (or `seconds`) at 30 fps, side by side: left view red-ish, right view blue-ish, each with a
 // white box that moves 5 px per frame (the frame number, visible).
 inline std::filesystem::path make_clip(const TempDir& dir, int seconds = 2) {
-  const std::string d = ":d=" + std::to_string(seconds);
-  return make_media(
-      dir / "clip.mp4",
-      "-f lavfi -i color=c=0xC03020:s=320x180:r=30" + d + " -f lavfi -i color=c=0x2040C0:s=320x180:r=30" + d +
-          " -f lavfi -i color=c=white:s=20x60:r=30" + d +
-          " -filter_complex "
-          "\"[2]split[b1][b2];[0][b1]overlay=x='mod(n*5,300)':y=60[l];[1][b2]overlay=x='mod(n*5,300)':y=60[r];"
-          "[l][r]hstack\"" +
-          h264);
+  return make_moving_box_clip(dir / "clip.mp4", seconds, 30, false);
 }
 
 struct Mean {

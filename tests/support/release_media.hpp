@@ -20,7 +20,6 @@ inline std::filesystem::path make_release_mkv(const std::filesystem::path& dir, 
              "[CHAPTER]\nTIMEBASE=1/1000\nSTART=0\nEND=1500\ntitle=A\n"
              "[CHAPTER]\nTIMEBASE=1/1000\nSTART=1500\nEND=3000\ntitle=B\n"
              "[CHAPTER]\nTIMEBASE=1/1000\nSTART=3000\nEND=6000\ntitle=C\n");
-  const auto q = [](const std::filesystem::path& p) { return shell_quote(p.string()); };
   return make_media(
       dir / name,
       "-f lavfi -i testsrc2=s=320x180:r=10 -f lavfi -i sine=duration=6:sample_rate=48000 -f lavfi -i "

@@ -59,8 +59,7 @@ CommandResult run_command(const std::string& command_line) {
   TempDir dir;
   const auto out_path = dir / "stdout";
   const auto err_path = dir / "stderr";
-  const std::string full = "( " + command_line + " ) >" + shell_quote(out_path.string()) + " 2>" +
-                           shell_quote(err_path.string()) + " </dev/null";
+  const std::string full = "( " + command_line + " ) >" + q(out_path) + " 2>" + q(err_path) + " </dev/null";
   const int raw = std::system(full.c_str());
   CommandResult r;
   if (raw == -1) throw std::runtime_error("cannot run: " + command_line);
@@ -107,9 +106,9 @@ virtual_image_mm = 1000.0
 std::filesystem::path write_lavfi_still(const TempDir& dir, const std::string& name, const std::string& source,
                                         const std::string& filters) {
   const auto path = dir / name;
-  const CommandResult r = run_command("ffmpeg -loglevel error -f lavfi -i " + shell_quote(source) +
-                                      (filters.empty() ? "" : " -vf " + shell_quote(filters)) + " -frames:v 1 " +
-                                      shell_quote(path.string()));
+  const CommandResult r =
+      run_command("ffmpeg -loglevel error -f lavfi -i " + shell_quote(source) +
+                  (filters.empty() ? "" : " -vf " + shell_quote(filters)) + " -frames:v 1 " + q(path));
   EXPECT_EQ(r.status, 0) << r.err;
   return path;
 }

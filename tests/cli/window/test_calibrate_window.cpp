@@ -28,6 +28,7 @@ namespace nelf {
 namespace {
 
 using test::run_command;
+using test::q;
 using test::shell_quote;
 using test::TempDir;
 
@@ -36,8 +37,7 @@ using test::TempDir;
 class NelfProcess {
  public:
   NelfProcess(const std::string& args, const std::filesystem::path& out, const std::filesystem::path& err) {
-    const std::string command = "exec " + shell_quote(NELF_BINARY) + " " + args + " >" + shell_quote(out.string()) +
-                                " 2>" + shell_quote(err.string());
+    const std::string command = "exec " + shell_quote(NELF_BINARY) + " " + args + " >" + q(out) + " 2>" + q(err);
     pid_ = fork();
     if (pid_ == 0) {
       execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
@@ -103,7 +103,7 @@ class CalibrateWindowTest : public ::testing::Test {
 
 TEST_F(CalibrateWindowTest, KeysChangeWhatSaveWrites) {
   const auto saved = dir_ / "mine.toml";
-  NelfProcess nelf("calibrate --save " + shell_quote(saved.string()), dir_ / "out.txt", dir_ / "err.txt");
+  NelfProcess nelf("calibrate --save " + q(saved), dir_ / "out.txt", dir_ / "err.txt");
   const std::string window = find_window(nelf);
   ASSERT_FALSE(window.empty()) << test::read_file(dir_ / "err.txt");
   // Both eyes 2 px right; the left eye rotated +0.1 deg and 0.1 px up; the right eye 1 px left;
@@ -133,12 +133,12 @@ TEST_F(CalibrateWindowTest, KeysChangeWhatSaveWrites) {
 
   // The saved profile is a profile like any other: convert and calibrate accept it.
   test::write_test_image(dir_ / "sbs.png", test::filled_image(128, 36, Rgba{0.8f, 0.5f, 0.2f, 1.f}), 3);
-  auto r = run_command(shell_quote(NELF_BINARY) + " convert --profile " + shell_quote(saved.string()) + " " +
-                       shell_quote((dir_ / "sbs.png").string()) + " " + shell_quote((dir_ / "packed.png").string()));
+  auto r = run_command(shell_quote(NELF_BINARY) + " convert --profile " + q(saved) + " " + q(dir_ / "sbs.png") + " " +
+                       q(dir_ / "packed.png"));
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(test::read_back(dir_ / "packed.png").height, 1470);
-  r = run_command(shell_quote(NELF_BINARY) + " calibrate --pattern grid --profile " + shell_quote(saved.string()) +
-                  " --output " + shell_quote((dir_ / "grid.png").string()));
+  r = run_command(shell_quote(NELF_BINARY) + " calibrate --pattern grid --profile " + q(saved) + " --output " +
+                  q(dir_ / "grid.png"));
   EXPECT_EQ(r.status, 0) << r.err;
 }
 
@@ -149,9 +149,8 @@ TEST_F(CalibrateWindowTest, WritesOnWAndStartsFromTheGivenProfile) {
   Profile start = load_profile("hmz-t1");
   start.viewing.ipd_mm = 60.0;
   test::write_file(saved, profile_to_toml(start));
-  NelfProcess nelf(
-      "calibrate --pattern grid --profile " + shell_quote(saved.string()) + " --save " + shell_quote(saved.string()),
-      dir_ / "out.txt", dir_ / "err.txt");
+  NelfProcess nelf("calibrate --pattern grid --profile " + q(saved) + " --save " + q(saved), dir_ / "out.txt",
+                   dir_ / "err.txt");
   const std::string window = find_window(nelf);
   ASSERT_FALSE(window.empty()) << test::read_file(dir_ / "err.txt");
   keys(nelf, window, "bracketleft w");
@@ -197,8 +196,7 @@ TEST_F(CalibrateWindowTest, TheWindowShowsWhatTheHeadlessPatternWrites) {
   ASSERT_EQ(width, 1280) << geometry;
   ASSERT_EQ(height, 1470) << geometry;
   const auto written = dir_ / "written.png";
-  auto r =
-      run_command(shell_quote(NELF_BINARY) + " calibrate --pattern grid --output " + shell_quote(written.string()));
+  auto r = run_command(shell_quote(NELF_BINARY) + " calibrate --pattern grid --output " + q(written));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto b = test::read_back(written);
   ASSERT_EQ(b.width, width);
@@ -216,7 +214,7 @@ TEST_F(CalibrateWindowTest, TheWindowShowsWhatTheHeadlessPatternWrites) {
     std::filesystem::remove(shown);
     r = run_command(
         fmt::format("ffmpeg -loglevel error -f x11grab -draw_mouse 0 -video_size {}x{} -i {}+{},{} -frames:v 1 {}",
-                    width, height, xvfb_.display_name(), x, y, shell_quote(shown.string())));
+                    width, height, xvfb_.display_name(), x, y, q(shown)));
     ASSERT_EQ(r.status, 0) << r.err;
     ++captures;
     const auto a = test::read_back(shown);
@@ -244,7 +242,7 @@ TEST_F(CalibrateWindowTest, TheWindowShowsWhatTheHeadlessPatternWrites) {
 
 TEST_F(CalibrateWindowTest, ClosingTheWindowSavesAndExitsCleanly) {
   const auto saved = dir_ / "closed.toml";
-  NelfProcess nelf("calibrate --save " + shell_quote(saved.string()), dir_ / "out.txt", dir_ / "err.txt");
+  NelfProcess nelf("calibrate --save " + q(saved), dir_ / "out.txt", dir_ / "err.txt");
   const std::string window = find_window(nelf);
   ASSERT_FALSE(window.empty()) << test::read_file(dir_ / "err.txt");
   keys(nelf, window, "D D");
@@ -260,7 +258,7 @@ TEST_F(CalibrateWindowTest, DefectsKeysMarkPixelsAndSaveTheMapBesideTheProfile) 
   // --defects from the built-in (no map named): the marks go to mine.defects beside --save
   // mine.toml, which names it. The cursor starts at the centre of the left panel (640, 360).
   const auto saved = dir_ / "mine.toml";
-  NelfProcess nelf("calibrate --defects --save " + shell_quote(saved.string()), dir_ / "out.txt", dir_ / "err.txt");
+  NelfProcess nelf("calibrate --defects --save " + q(saved), dir_ / "out.txt", dir_ / "err.txt");
   const std::string window = find_window(nelf);
   ASSERT_FALSE(window.empty()) << test::read_file(dir_ / "err.txt");
   // Left (640, 360) dead; 11 px right on the white field stuck white; the right eye 100 px up and
@@ -295,7 +293,7 @@ TEST_F(CalibrateWindowTest, DefectsKeysMarkPixelsAndSaveTheMapBesideTheProfile) 
 TEST(CalibrateWindowErrors, NoDisplayIsOneLineAndNothingSaved) {
   TempDir dir;
   test::ScopedDisplay no_display("");
-  const auto r = run_command(shell_quote(NELF_BINARY) + " calibrate --save " + shell_quote((dir / "x.toml").string()));
+  const auto r = run_command(shell_quote(NELF_BINARY) + " calibrate --save " + q(dir / "x.toml"));
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find("DISPLAY"), std::string::npos) << r.err;
@@ -305,11 +303,10 @@ TEST(CalibrateWindowErrors, NoDisplayIsOneLineAndNothingSaved) {
 TEST(CalibrateWindowErrors, BadSavePathIsRefusedBeforeOpeningAWindow) {
   TempDir dir;
   test::ScopedDisplay no_display("");  // would fail later; the --save check comes first
-  auto r =
-      run_command(shell_quote(NELF_BINARY) + " calibrate --save " + shell_quote((dir / "missing" / "x.toml").string()));
+  auto r = run_command(shell_quote(NELF_BINARY) + " calibrate --save " + q(dir / "missing" / "x.toml"));
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
-  r = run_command(shell_quote(NELF_BINARY) + " calibrate --save " + shell_quote((dir / "x.txt").string()));
+  r = run_command(shell_quote(NELF_BINARY) + " calibrate --save " + q(dir / "x.txt"));
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("a profile is a .toml file"), std::string::npos) << r.err;
   // KMS: the KMS display's own one-line error, through calibrate (a missing device here, so that

@@ -30,6 +30,7 @@ namespace {
 using namespace std::chrono_literals;
 using test::run_command;
 using test::run_nelf;
+using test::q;
 using test::shell_quote;
 
 class LiveCliTest : public ::testing::Test {
@@ -42,15 +43,14 @@ class LiveCliTest : public ::testing::Test {
 TEST_F(LiveCliTest, ConvertRecordsAGameWindowForTheHmd) {
   test::TestGame game({"--mode", "sbs", "--size", "320x180", "--fps", "30", "--title", "record me"});
   const auto out = dir_.path() / "game.mkv";
-  const auto r = run_nelf("convert " + shell_quote("x11:wait=10,window=record me") + " " + shell_quote(out.string()) +
-                          " --duration 2");
+  const auto r = run_nelf("convert " + shell_quote("x11:wait=10,window=record me") + " " + q(out) + " --duration 2");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("window 0x"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("layout sbs (aspect)"), std::string::npos) << r.err;
   const std::string stream = run_command(
                                  "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
                                  "stream=width,height,nb_read_frames -of csv=p=0 " +
-                                 shell_quote(out.string()))
+                                 q(out))
                                  .out;
   std::smatch m;
   ASSERT_TRUE(std::regex_search(stream, m, std::regex("1280,1470,(\\d+)"))) << stream;  // hmz-t1: frame packing
@@ -61,27 +61,26 @@ TEST_F(LiveCliTest, CtrlCEndsARecordingWithACompleteFile) {
   // --duration: were Ctrl-C missed, the test fails rather than waits for ever.
   test::TestGame game({"--mode", "tab", "--size", "320x180", "--fps", "30", "--title", "stop me", "--duration", "60"});
   const auto out = dir_.path() / "stopped.mkv";
-  const auto r =
-      run_command("( " + std::string(NELF_BINARY) + " convert " + shell_quote("x11:wait=10,window=stop me") + " " +
-                  shell_quote(out.string()) + " & pid=$!; sleep 3; kill -INT $pid; wait $pid; echo status=$? )");
+  const auto r = run_command("( " + std::string(NELF_BINARY) + " convert " + shell_quote("x11:wait=10,window=stop me") +
+                             " " + q(out) + " & pid=$!; sleep 3; kill -INT $pid; wait $pid; echo status=$? )");
   EXPECT_NE(r.out.find("status=0"), std::string::npos) << r.out << r.err;
   EXPECT_NE(r.err.find("layout tab (aspect)"), std::string::npos) << r.err;
   ASSERT_TRUE(std::filesystem::exists(out)) << r.err;
-  const auto decoded = run_command("ffmpeg -v error -i " + shell_quote(out.string()) + " -f null -");
+  const auto decoded = run_command("ffmpeg -v error -i " + q(out) + " -f null -");
   EXPECT_EQ(decoded.status, 0);
   EXPECT_EQ(decoded.err, "") << "every frame decodes";
   const auto frames = run_command(
       "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
       "stream=nb_read_frames -of csv=p=0 " +
-      shell_quote(out.string()));
+      q(out));
   EXPECT_GE(std::stoi(frames.out), 10) << frames.out;
 }
 
 TEST_F(LiveCliTest, PlayShowsAWindowUntilItCloses) {
   test::TestGame game({"--mode", "sbs", "--size", "320x180", "--fps", "30", "--duration", "6", "--title", "watch me"});
   const auto log = dir_.path() / "frames.csv";
-  const auto r = run_nelf("play " + shell_quote("x11:wait=10,window=watch me") + " --output offscreen --log-frames " +
-                          shell_quote(log.string()));
+  const auto r =
+      run_nelf("play " + shell_quote("x11:wait=10,window=watch me") + " --output offscreen --log-frames " + q(log));
   ASSERT_EQ(r.status, 0) << r.err;
   std::smatch m;
   ASSERT_TRUE(std::regex_search(r.err, m, std::regex("(\\d+) frames shown"))) << r.err;
@@ -91,8 +90,8 @@ TEST_F(LiveCliTest, PlayShowsAWindowUntilItCloses) {
 
 TEST_F(LiveCliTest, RunStartsTheGamePlaysItsWindowAndEndsWithIt) {
   const auto log = dir_.path() / "frames.csv";
-  const auto r = run_nelf("run --output offscreen --log-frames " + shell_quote(log.string()) + " -- " +
-                          shell_quote(NELF_TEST_GAME) + " --mode sbs --size 320x180 --fps 30 --duration 6");
+  const auto r = run_nelf("run --output offscreen --log-frames " + q(log) + " -- " + shell_quote(NELF_TEST_GAME) +
+                          " --mode sbs --size 320x180 --fps 30 --duration 6");
   ASSERT_EQ(r.status, 0) << r.err;
   // Its picture, read by nelf's interposer at each swap (not through the X server).
   EXPECT_NE(r.err.find("the window of an OpenGL game (process "), std::string::npos) << r.err;
@@ -123,9 +122,8 @@ TEST_F(LiveCliTest, RunGivesAQuadBufferGameBothEyes) {
   for (const char* toolkit : {"glfw", "sdl2"}) {
     SCOPED_TRACE(toolkit);
     const auto log = dir_.path() / (std::string(toolkit) + ".csv");
-    const auto r = run_nelf("run --output offscreen --log-frames " + shell_quote(log.string()) + " -- " +
-                            shell_quote(NELF_TEST_GAME) + " --toolkit " + toolkit +
-                            " --mode quad-buffer --size 320x180 --fps 30 --duration 5");
+    const auto r = run_nelf("run --output offscreen --log-frames " + q(log) + " -- " + shell_quote(NELF_TEST_GAME) +
+                            " --toolkit " + toolkit + " --mode quad-buffer --size 320x180 --fps 30 --duration 5");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find("a quad-buffer OpenGL game, two 320x180 eyes, live"), std::string::npos) << r.err;
     std::smatch m;
@@ -183,7 +181,7 @@ TEST_F(LiveCliTest, RunPacesAGameThatAsksForVsyncToTheDisplaysRefreshes) {
     const auto log = dir_.path() / ("game" + std::to_string(interval) + mode + ".csv");
     const auto r = run_nelf("run --output offscreen --no-audio -- " + shell_quote(NELF_TEST_GAME) + " --mode " + mode +
                             " --size 320x180 --fps 250 --duration 3 --swap-interval " + std::to_string(interval) +
-                            " --log " + shell_quote(log.string()));
+                            " --log " + q(log));
     EXPECT_EQ(r.status, 0) << r.err;
     std::ifstream in(log);
     std::string line;
@@ -218,7 +216,7 @@ TEST_F(LiveCliTest, SimulateShowsWhatTheEyeSeesOfAGamesFrameWithItsDepth) {
       {"LD_PRELOAD=" + glx_stereo_library_path(), std::string(glx_stereo::kSocketVariable) + "=" + socket});
   const auto json_of = [&](const std::string& depth) {
     const auto r = run_nelf("simulate " + shell_quote("glx-stereo:wait=20,socket=" + socket) + " --depth " + depth +
-                            " --json -o " + shell_quote((dir_.path() / (depth + ".png")).string()));
+                            " --json -o " + q(dir_.path() / (depth + ".png")));
     EXPECT_EQ(r.status, 0) << r.err;
     return nlohmann::json::parse(r.out);
   };
@@ -238,28 +236,27 @@ TEST_F(LiveCliTest, SimulateShowsWhatTheEyeSeesOfAGamesFrameWithItsDepth) {
 TEST_F(LiveCliTest, FfmpegCaptureDevicesAreInputsToo) {
   // lavfi: a filter graph read as a device; x11grab: FFmpeg's own screen grabber on this Xvfb.
   const auto graph = dir_.path() / "graph.mkv";
-  const auto r = run_nelf("convert " + shell_quote("device:lavfi:testsrc2=size=640x180:rate=30") + " " +
-                          shell_quote(graph.string()) + " --duration 1");
+  const auto r = run_nelf("convert " + shell_quote("device:lavfi:testsrc2=size=640x180:rate=30") + " " + q(graph) +
+                          " --duration 1");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("layout sbs (aspect)"), std::string::npos) << r.err;
   const auto frames = [](const std::filesystem::path& file) {
     return run_command(
                "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
                "stream=width,height,nb_read_frames -of csv=p=0 " +
-               shell_quote(file.string()))
+               q(file))
         .out;
   };
   EXPECT_EQ(frames(graph), "1280,1470,30\n");
   const auto screen = dir_.path() / "screen.mkv";
-  const auto grabbed = run_nelf("convert " + shell_quote("device:x11grab:" + xvfb_.display_name()) + " " +
-                                shell_quote(screen.string()) + " --layout mono --frames 5");
+  const auto grabbed = run_nelf("convert " + shell_quote("device:x11grab:" + xvfb_.display_name()) + " " + q(screen) +
+                                " --layout mono --frames 5");
   ASSERT_EQ(grabbed.status, 0) << grabbed.err;
   EXPECT_EQ(frames(screen), "1280,1470,5\n");
   // The device's own options, as ffmpeg takes -video_size before -i: x11grab grabs 320x240 of the screen.
-  const auto corner =
-      run_nelf("convert " + shell_quote("device:x11grab:" + xvfb_.display_name()) + " " +
-               shell_quote((dir_.path() / "corner.mkv").string()) +
-               " --layout mono --frames 2 --device-option video_size=320x240 --device-option framerate=10");
+  const auto corner = run_nelf(
+      "convert " + shell_quote("device:x11grab:" + xvfb_.display_name()) + " " + q(dir_.path() / "corner.mkv") +
+      " --layout mono --frames 2 --device-option video_size=320x240 --device-option framerate=10");
   ASSERT_EQ(corner.status, 0) << corner.err;
   EXPECT_NE(corner.err.find(": 320x240 rawvideo, layout mono"), std::string::npos) << corner.err;
 }
