@@ -2,10 +2,12 @@
 // stereo source (glx_stereo_source.hpp).
 // Each frame is the newest the game swapped: older ones still in the socket are skipped, as a live
 // window's are, and a slot the game overwrote while it was copied is dropped and counted.
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <poll.h>
 #include <sys/mman.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/time.h>
 #include <unistd.h>
 
@@ -16,6 +18,7 @@
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "core/module_path.hpp"
 #include "core/printable.hpp"
@@ -96,6 +99,25 @@ std::optional<Received> receive(int fd, bool wait) {
   return r;
 }
 
+// Why the frame memory a hello attached cannot be read safely, or nothing. It must hold the frames
+// the hello announces and be sealed against shrinking: a read of a page the game truncated away
+// would kill nelf with SIGBUS instead of failing.
+std::optional<std::string> frame_memory_problem(const Received& hello) {
+  const std::uint32_t w = hello.message.width, h = hello.message.height;
+  if (w == 0 || h == 0 || w > protocol::kMaxSide || h > protocol::kMaxSide)
+    return fmt::format("the game's interposer announces {}x{} frames (each side 1 to {})", w, h, protocol::kMaxSide);
+  if (hello.attached.get() < 0) return std::string("the game's interposer attached no frame memory");
+  const std::size_t needed = protocol::shared_bytes(w, h);
+  struct stat status {};
+  if (::fstat(hello.attached.get(), &status) != 0 || static_cast<std::uint64_t>(status.st_size) < needed)
+    return fmt::format("the game's frame memory holds {} bytes where its {}x{} frames need {} (another nelf version?)",
+                       static_cast<long long>(status.st_size), w, h, needed);
+  const int seals = ::fcntl(hello.attached.get(), F_GET_SEALS);
+  if (seals < 0 || (seals & F_SEAL_SHRINK) == 0)
+    return std::string("the game's frame memory is not sealed against shrinking (another nelf version?)");
+  return std::nullopt;
+}
+
 struct Unmap {
   std::size_t bytes = 0;
   void operator()(unsigned char* p) const { munmap(p, bytes); }
@@ -126,13 +148,13 @@ class GlxStereoSource final : public Source {
       throw UserError(fmt::format("{}: the game's interposer said something else than hello (another nelf version?)",
                                   printable(input_)),
                       1);
+    if (const auto problem = frame_memory_problem(*hello))
+      throw UserError(fmt::format("{}: {}", printable(input_), *problem), 1);
     picture_ = !hello->message.stereo;
     width_ = static_cast<int>(hello->message.width);
     height_ = static_cast<int>(hello->message.height);
     const std::size_t bytes = protocol::shared_bytes(hello->message.width, hello->message.height);
-    void* mapped = hello->attached.get() >= 0 && width_ > 0 && height_ > 0
-                       ? mmap(nullptr, bytes, PROT_READ, MAP_SHARED, hello->attached.get(), 0)
-                       : MAP_FAILED;
+    void* mapped = mmap(nullptr, bytes, PROT_READ, MAP_SHARED, hello->attached.get(), 0);
     if (mapped == MAP_FAILED) throw UserError(fmt::format("{}: cannot map the game's frames", printable(input_)), 1);
     shared_ = std::unique_ptr<unsigned char, Unmap>(static_cast<unsigned char*>(mapped), Unmap{bytes});
     if (picture_) {

@@ -4,8 +4,9 @@
 // shared memory it passes. Plain C++ without nelf's other headers: the interposer includes it too.
 //
 // The game's side connects to $NELF_GLX_STEREO_SOCKET at its first buffer swap and sends a hello
-// with a memfd of kSlots frame slots attached (SCM_RIGHTS): stereo (it drew into GL_BACK_RIGHT, so
-// the interposer keeps each eye's back buffer; a slot holds both eyes), or mono, for a game that
+// with a memfd of kSlots frame slots attached (SCM_RIGHTS; its size sealed, so that nelf's reads
+// can never fault on pages the game took away — nelf refuses a memfd that could shrink): stereo (it drew into
+// GL_BACK_RIGHT, so the interposer keeps each eye's back buffer; a slot holds both eyes), or mono, for a game that
 // draws one picture (after a few swaps without a right buffer; a slot holds the window's picture
 // where a left eye goes, and nelf splits it by its layout). A new window, or a new size, is a new
 // link. Then one frame message per swap, naming the slot just written. nelf may answer once with
@@ -20,13 +21,19 @@
 // (vsync_returns_ns). The slots are written in turn and guarded by a sequence number (odd while
 // written), so that a reader that fell behind notices a slot overwritten under it instead of
 // showing a torn frame; the game never waits for nelf.
+#include <sys/socket.h>
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 namespace nelf::glx_stereo {
 
-inline constexpr std::uint32_t kMagic = 0x4e4c4635;  // "NLF5"
+inline constexpr std::uint32_t kMagic = 0x4e4c4636;  // "NLF6"
+// The largest eye (or picture) side a hello may give, in pixels: GL's usual largest texture, and a
+// bound that keeps the shared memory's size well within size_t.
+inline constexpr std::uint32_t kMaxSide = 16384;
 inline constexpr int kSlots = 3;
 inline constexpr const char* kSocketVariable = "NELF_GLX_STEREO_SOCKET";
 
@@ -75,6 +82,26 @@ inline std::size_t slot_stride(std::uint32_t width, std::uint32_t height) {
 }
 inline std::size_t shared_bytes(std::uint32_t width, std::uint32_t height) {
   return kSlots * slot_stride(width, height);
+}
+
+// Sends `message` on `link` with `attached` (a descriptor, or < 0 for none) as SCM_RIGHTS, as the
+// hello's frame memory travels; sendmsg's result.
+inline ssize_t send_message(int link, const Message& message, int attached, int flags) {
+  iovec io{const_cast<Message*>(&message), sizeof message};
+  msghdr header{};
+  header.msg_iov = &io;
+  header.msg_iovlen = 1;
+  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
+  if (attached >= 0) {
+    header.msg_control = control;
+    header.msg_controllen = sizeof control;
+    cmsghdr* c = CMSG_FIRSTHDR(&header);
+    c->cmsg_level = SOL_SOCKET;
+    c->cmsg_type = SCM_RIGHTS;
+    c->cmsg_len = CMSG_LEN(sizeof(int));
+    std::memcpy(CMSG_DATA(c), &attached, sizeof(int));
+  }
+  return ::sendmsg(link, &header, flags);
 }
 
 // nelf's refreshes as its refresh messages said them (period 0: none said).

@@ -1,5 +1,6 @@
 #include "inputs/glx_interposer/nelf_link.hpp"
 
+#include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/socket.h>
 #include <sys/un.h>
@@ -37,8 +38,9 @@ bool NelfLink::connect(bool stereo, std::uint32_t width, std::uint32_t height) {
   int memory = -1;
   if (width > 0 && height > 0) {
     bytes_ = protocol::shared_bytes(width, height);
-    memory = memfd_create("nelf-glx-stereo", MFD_CLOEXEC);
-    if (memory < 0 || ftruncate(memory, static_cast<off_t>(bytes_)) != 0) {
+    memory = memfd_create("nelf-glx-stereo", MFD_CLOEXEC | MFD_ALLOW_SEALING);
+    if (memory < 0 || ftruncate(memory, static_cast<off_t>(bytes_)) != 0 ||
+        fcntl(memory, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_SEAL) != 0) {
       if (memory >= 0) ::close(memory);
       close();
       return false;
@@ -103,22 +105,8 @@ void NelfLink::close() {
 }
 
 bool NelfLink::send(const protocol::Message& message, int attached_fd) {
-  iovec io{const_cast<protocol::Message*>(&message), sizeof message};
-  msghdr header{};
-  header.msg_iov = &io;
-  header.msg_iovlen = 1;
-  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
-  if (attached_fd >= 0) {
-    header.msg_control = control;
-    header.msg_controllen = sizeof control;
-    cmsghdr* c = CMSG_FIRSTHDR(&header);
-    c->cmsg_level = SOL_SOCKET;
-    c->cmsg_type = SCM_RIGHTS;
-    c->cmsg_len = CMSG_LEN(sizeof(int));
-    std::memcpy(CMSG_DATA(c), &attached_fd, sizeof(int));
-  }
   const int flags = MSG_NOSIGNAL | (attached_fd >= 0 ? 0 : MSG_DONTWAIT);
-  const ssize_t n = ::sendmsg(fd_, &header, flags);
+  const ssize_t n = protocol::send_message(fd_, message, attached_fd, flags);
   if (n == static_cast<ssize_t>(sizeof message)) return true;
   if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return true;
   close();
