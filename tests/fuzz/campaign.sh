@@ -19,7 +19,7 @@ out=${2:?usage: campaign.sh BUILD_DIR OUT_DIR CPU_SECONDS [TARGET...]}
 budget=${3:?usage: campaign.sh BUILD_DIR OUT_DIR CPU_SECONDS [TARGET...]}
 shift 3
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(profile stereo_layout stereo_metadata still video)
+[ ${#targets[@]} -eq 0 ] && targets=(profile defect_map stereo_layout stereo_metadata still video)
 here=$(cd "$(dirname "$0")" && pwd)
 out=$(mkdir -p "$out" && cd "$out" && pwd)
 

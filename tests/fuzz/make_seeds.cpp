@@ -98,6 +98,20 @@ void make_seeds(const fs::path& out, const fs::path& profiles) {
   int n = 0;
   for (const char* name : names) s.seed("stereo_layout", "name" + std::to_string(n++), name);
 
+  // Defect maps: selector = built-in profile in name order (0 hmz-t1, 1 hmz-t1-stock, 2
+  // ii-2160-testbed, 3 lvt-prototype; fuzz_defect_map.cpp), then the map's text.
+  const std::string defects =
+      "# a dead pixel in the lit block, a stuck one near the panel's edge\n"
+      "left 640 360 dead\n"
+      "right 12 700 stuck 255 255 255   # white\n";
+  std::string cluster;  // a 3 x 3 block: the bundles of its middle lose their healthy pixels
+  for (int y = 359; y <= 361; ++y)
+    for (int x = 639; x <= 641; ++x) cluster += "left " + std::to_string(x) + " " + std::to_string(y) + " dead\n";
+  for (char profile = 0; profile < 4; ++profile) {
+    s.seed("defect_map", "map" + std::to_string(profile), profile, defects);
+    s.seed("defect_map", "cluster" + std::to_string(profile), profile, cluster);
+  }
+
   // Stills: selector = extension (0 png, 1 jpg, 2 jps, 3 mpo) + 4 x name token (fuzz_still.cpp).
   const std::string png = s.media("a.png", picture("16x8"));
   const std::string gray16 = s.media("g.png", picture("8x8") + " -pix_fmt gray16be");

@@ -11,7 +11,7 @@ build=${1:?usage: run_fuzzers.sh BUILD_DIR SECONDS [TARGET...]}
 seconds=${2:?usage: run_fuzzers.sh BUILD_DIR SECONDS [TARGET...]}
 shift 2
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(profile stereo_layout stereo_metadata still video)
+[ ${#targets[@]} -eq 0 ] && targets=(profile defect_map stereo_layout stereo_metadata still video)
 here=$(cd "$(dirname "$0")" && pwd)
 # A single input must finish in this many seconds; the machine may be busy, so it is generous.
 timeout_s=${FUZZ_INPUT_TIMEOUT:-30}
