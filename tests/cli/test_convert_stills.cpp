@@ -20,7 +20,6 @@ using test::filled_image;
 using test::q;
 using test::read_back;
 using test::run_nelf;
-using test::q;
 using test::TempDir;
 using test::write_test_image;
 

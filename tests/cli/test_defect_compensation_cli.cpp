@@ -20,7 +20,6 @@ namespace {
 using test::q;
 using test::read_back;
 using test::run_nelf;
-using test::q;
 using test::TempDir;
 
 // The small 160×90 test panel, with the defect map or without.

@@ -15,7 +15,6 @@ namespace {
 using test::expect_clean_failure;
 using test::q;
 using test::run_nelf;
-using test::q;
 using test::TempDir;
 
 // Bytes a terminal would act on: C0 controls (the final newline aside), DEL, C1 controls in UTF-8.

@@ -17,7 +17,6 @@ namespace {
 using test::expect_clean_failure;
 using test::make_media;
 using test::q;
-using test::q;
 using test::TempDir;
 
 // A flat grey 8-bit PNG of `width` x `height`, written row by row: a decompression bomb (16384x16384
