@@ -4,23 +4,23 @@
 // shared memory it passes. Plain C++ without nelf's other headers: the interposer includes it too.
 //
 // The game's side connects to $NELF_GLX_STEREO_SOCKET at its first buffer swap and sends a hello
-// with a memfd of kSlots frame slots attached (SCM_RIGHTS; its size sealed, so that nelf's reads
-// can never fault on pages the game took away — nelf refuses a memfd that could shrink): stereo (it drew into
-// GL_BACK_RIGHT, so the interposer keeps each eye's back buffer; a slot holds both eyes), or mono, for a game that
-// draws one picture (after a few swaps without a right buffer; a slot holds the window's picture
-// where a left eye goes, and nelf splits it by its layout). A new window, or a new size, is a new
-// link. Then one frame message per swap, naming the slot just written. nelf may answer once with
-// want_depth (it composites with the game's depth, `--depth auto`): from then on each slot also
-// holds both eyes' depth buffers. While nelf shows the frames on a display that refreshes at a fixed
-// rate (play, run) it sends a refresh message at each refresh: its time, the period, and how long
-// before a refresh a swapped frame must be to be in it (nelf's read of the last frames, and a
-// margin). A game that asks for a swap interval of N (glXSwapInterval*, 1 when it never asks, as
-// GLX has it) then has each buffer swap return so that its next frame, drawn in the time its last
-// one took, is swapped that long before a refresh, N refreshes on: it is shown at the first refresh
-// it can be, as vsync does on a monitor, and no later; while nelf says no refresh, at 60 Hz
-// (vsync_returns_ns). The slots are written in turn and guarded by a sequence number (odd while
-// written), so that a reader that fell behind notices a slot overwritten under it instead of
-// showing a torn frame; the game never waits for nelf.
+// with a memfd of kSlots frame slots attached (SCM_RIGHTS; sealed at its size, so that nelf's reads
+// can never fault on pages the game took away: nelf refuses a memfd that could shrink): stereo (it
+// drew into GL_BACK_RIGHT, so the interposer keeps each eye's back buffer; a slot holds both eyes),
+// or mono, for a game that draws one picture (after a few swaps without a right buffer; a slot
+// holds the window's picture where a left eye goes, and nelf splits it by its layout). A new
+// window, or a new size, is a new link. Then one frame message per swap, naming the slot just
+// written. nelf may answer once with want_depth (it composites with the game's depth, `--depth
+// auto`): from then on each slot also holds both eyes' depth buffers. While nelf shows the frames
+// on a display that refreshes at a fixed rate (play, run) it sends a refresh message at each
+// refresh: its time, the period, and how long before a refresh a swapped frame must be to be in it
+// (nelf's read of the last frames, and a margin). A game that asks for a swap interval of N
+// (glXSwapInterval*, 1 when it never asks, as GLX has it) then has each buffer swap return so that
+// its next frame, drawn in the time its last one took, is swapped that long before a refresh, N
+// refreshes on: it is shown at the first refresh it can be, as vsync does on a monitor, and no
+// later; while nelf says no refresh, at 60 Hz (vsync_returns_ns). The slots are written in turn and
+// guarded by a sequence number (odd while written), so that a reader that fell behind notices a
+// slot overwritten under it instead of showing a torn frame; the game never waits for nelf.
 #include <sys/socket.h>
 
 #include <algorithm>
