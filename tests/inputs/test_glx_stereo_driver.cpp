@@ -8,11 +8,9 @@
 #include <gtest/gtest.h>
 #include <sys/mman.h>
 #include <sys/socket.h>
-#include <sys/un.h>
 #include <unistd.h>
 
 #include <chrono>
-#include <cstring>
 #include <optional>
 #include <string>
 #include <thread>
@@ -71,14 +69,8 @@ class FakeInterposer {
           UniqueFd link;
           const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
           while (!stop.stop_requested() && std::chrono::steady_clock::now() < until) {
-            UniqueFd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
-            sockaddr_un address{};
-            address.sun_family = AF_UNIX;
-            std::strncpy(address.sun_path, socket.c_str(), sizeof address.sun_path - 1);
-            if (::connect(fd.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0) {
-              link = std::move(fd);
-              break;
-            }
+            link = test::connect_unix_socket(socket);
+            if (link.get() >= 0) break;
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
           }
           if (link.get() < 0) return;

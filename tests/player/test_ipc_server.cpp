@@ -22,12 +22,8 @@ namespace nelf::playback {
 namespace {
 
 UniqueFd connect_to(const std::filesystem::path& path) {
-  UniqueFd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
-  sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  std::strncpy(address.sun_path, path.c_str(), sizeof(address.sun_path) - 1);
-  EXPECT_EQ(::connect(fd.get(), reinterpret_cast<const sockaddr*>(&address), sizeof(address)), 0)
-      << std::strerror(errno);
+  UniqueFd fd = test::connect_unix_socket(path);
+  EXPECT_GE(fd.get(), 0) << std::strerror(errno);
   return fd;
 }
 

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "core/unix_socket.hpp"
+
 namespace nelf::test {
 
 // A fresh directory under the system temp dir, removed with everything in it on destruction.
@@ -72,6 +74,10 @@ std::filesystem::path write_lavfi_still(const TempDir& dir, const std::string& n
 std::string shell_quote(const std::string& s);
 // A path quoted for /bin/sh: the shorthand the command lines of the tests are written with.
 inline std::string q(const std::filesystem::path& p) { return shell_quote(p.string()); }
+
+// A stream socket connected to the Unix socket at `path`, as a client of nelf's (an IPC client, a
+// game's interposer); none (and errno saying why) when nothing listens there.
+UniqueFd connect_unix_socket(const std::filesystem::path& path);
 
 // The hmz-t1 optics (1.0 mm / f 3.3 mm sheet, 25 mm eye relief, image at 1 m) on half the pixels per
 // axis at twice the pitch (640x360 at 24 um): the same lens block, field of view, eye box and beams,
