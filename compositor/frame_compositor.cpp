@@ -146,8 +146,6 @@ void FrameCompositor::prepare(const Frame& frame, const FrameOverlays& overlays)
 // it pays (software GL, or NELF_COMPOSITE). Not with block means made for optics a key has changed
 // since (the GL path's smaller view covers the frames until the new block arrives).
 bool FrameCompositor::table_path_open() const {
-  // The tables replay the flat screen's taps; a frame with depth needs its own per pixel.
-  if (depth_frame_) return false;
   if (views_.width == 0 || views_.bits != 8 || (table_use_ == TableUse::block_means && !reduced())) return false;
   for (Eye eye : {Eye::left, Eye::right})
     if (layout_.origins[static_cast<int>(eye)] && views_.block != current_wanted_block(eye)) return false;
@@ -188,6 +186,10 @@ bool FrameCompositor::use_tables() {
     }
     if (!loaded && prefer_tables_) load(compositor_.get());
   }
+  // A frame with depth needs the depth-aware rays (recorded with them when depth is on).
+  if (depth_frame_)
+    for (const auto& table : tables_)
+      if (table && !table->has_depth()) return false;
   return tables_[0] || tables_[1];
 }
 
@@ -205,6 +207,10 @@ void FrameCompositor::forget_tables() {
 std::shared_ptr<const CompositeSetup> FrameCompositor::ahead_setup(const FrameOverlays& overlays,
                                                                    std::array<int, 2> packed) {
   if (!table_path_open() || !tables_tried_ || !(tables_[0] || tables_[1])) return nullptr;
+  bool depth = options_.depth != DepthMode::off && profile_.lens_array.has_value();
+  for (const auto& table : tables_) depth = depth && (!table || table->has_depth());
+  // Frames with depth that these tables cannot composite go to GL on the display's thread.
+  if (options_.depth != DepthMode::off && !depth) return nullptr;
   std::shared_ptr<const std::array<Image, 2>> grid;
   std::shared_ptr<const Image> message;
   EyeDefectPlans defects;
@@ -224,7 +230,7 @@ std::shared_ptr<const CompositeSetup> FrameCompositor::ahead_setup(const FrameOv
     if (!worker_tables_) worker_tables_ = std::make_shared<std::array<std::optional<CompositeTable>, 2>>(tables_);
     setup_ = std::make_shared<const CompositeSetup>(
         CompositeSetup{worker_tables_, layout_.origins, packed, overlays.swap_eyes, grid, views_.width, views_.height,
-                       views_.block, views_.aspect, message, defects});
+                       views_.block, views_.aspect, message, defects, depth});
   }
   return setup_;
 }
@@ -326,7 +332,7 @@ bool FrameCompositor::render(const Frame& frame, const FrameOverlays& overlays, 
 void FrameCompositor::render_tables(const FrameOverlays& overlays, const GlPackedTarget& target) {
   const auto views = covered_views(overlays);
   render_packed_frame(tables_, views, static_cast<std::size_t>(texture_w()) * 4, overlays.swap_eyes, layout_.origins,
-                      target.size, packed_);
+                      target.size, packed_, depth_surfaces());
   compensate_packed_eyes(defect_plans({content_aspect(), content_aspect()}, true), layout_.origins,
                          packed_.pixels.data(), static_cast<std::size_t>(target.size[0]) * 4, 8);
   upload_packed(target, packed_.pixels.data());
@@ -335,16 +341,23 @@ void FrameCompositor::render_tables(const FrameOverlays& overlays, const GlPacke
 // Both eyes from their tables straight into the packed frame's bytes (RGBA), black around them.
 void FrameCompositor::render_tables(const FrameOverlays& overlays, PackedFrame& out) {
   auto views = covered_views(overlays);
-  if (overlays.swap_eyes) std::swap(views[0], views[1]);
+  auto surfaces = depth_surfaces();
+  if (overlays.swap_eyes) std::swap(views[0], views[1]), std::swap(surfaces[0], surfaces[1]);
   out.bits = 8;
   out.rgba.resize(static_cast<std::size_t>(out.width) * out.height * 4);
   fill_outside_eyes(out.rgba.data());
   // While x264 fills its look-ahead the compositing is what a conversion waits for: the eyes
   // render in parallel.
   render_packed_eyes(tables_, views, static_cast<std::size_t>(texture_w()) * 4, layout_.origins, out.rgba.data(),
-                     static_cast<std::size_t>(out.width) * 4);
+                     static_cast<std::size_t>(out.width) * 4, ChannelOrder::rgba, surfaces);
   compensate_packed_eyes(defect_plans({content_aspect(), content_aspect()}, false), layout_.origins, out.rgba.data(),
                          static_cast<std::size_t>(out.width) * 4, 8);
+}
+
+// Per view, the surface the frame last prepared shows on the CPU path, or null (the flat screen).
+std::array<const DisparitySurface*, 2> FrameCompositor::depth_surfaces() const {
+  if (!depth_frame_) return {};
+  return {surfaces_[0].get(), surfaces_[1].get()};
 }
 
 // Opaque black wherever the eyes do not draw (the gap, and borders when a panel is smaller than its

@@ -128,8 +128,8 @@ class FrameCompositor {
   void wait_for_ahead(std::chrono::milliseconds timeout) { ahead_.wait_until_idle(timeout); }
 
   // Whether the frame last prepared is composited with its depth (options().depth, the frame's
-  // disparity, a lens-array profile): such frames go the GL path, each pixel showing the view where
-  // its ray meets the content's surface.
+  // disparity, a lens-array profile): each pixel then shows the view where its ray meets the
+  // content's surface, on GL or (where the tables pay) from the tables' depth-aware rays.
   bool depth_aware() const { return depth_frame_; }
 
   // The defect compensation eye `eye` takes for frames of the current views (or, after a still,
@@ -166,6 +166,7 @@ class FrameCompositor {
   void render_tables(const FrameOverlays& overlays, const GlPackedTarget& target);
   void render_tables(const FrameOverlays& overlays, PackedFrame& out);
   void fill_outside_eyes(std::uint8_t* rgba) const;
+  std::array<const DisparitySurface*, 2> depth_surfaces() const;
   void render_gl(const FrameOverlays& overlays, unsigned int framebuffer);
   void upload_views();
   void upload_packed(const GlPackedTarget& target, const std::uint8_t* bgra);

@@ -6,6 +6,11 @@
 #include <limits>
 #include <stdexcept>
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define NELF_DEPTH_AVX2 1
+#endif
+
 namespace nelf {
 
 DepthGeometry depth_geometry(const Profile& profile, const EyeMapping& mapping) {
@@ -131,6 +136,133 @@ Vec2 DisparitySurface::hit(Vec2 flat_uv, Vec2 gain) const {
     next[a] += delta[a];
   }
   return along(back);
+}
+
+#if defined(NELF_DEPTH_AVX2)
+namespace {
+
+// Floor as int32 lanes, NaN to the low end (max returns its second operand then), held where the
+// conversion is defined.
+__attribute__((target("avx2"), always_inline)) inline __m256i floor_index(__m256 p) {
+  p = _mm256_min_ps(_mm256_max_ps(p, _mm256_set1_ps(-1e6f)), _mm256_set1_ps(1e6f));
+  return _mm256_cvttps_epi32(_mm256_floor_ps(p));
+}
+__attribute__((target("avx2"), always_inline)) inline __m256i clamp_index(__m256i i, __m256i last) {
+  return _mm256_min_epi32(_mm256_max_epi32(i, _mm256_setzero_si256()), last);
+}
+
+// Eight rays of four floats (u, v, gain_u, gain_v) as four registers of one field each, by a 4×4
+// transpose within each 128-bit half (gathers cost several times more on some CPUs). The lanes
+// then hold rays 0 2 4 6 1 3 5 7; ray_order puts results back in order.
+struct RayFields {
+  __m256 u, v, gain_u, gain_v;
+};
+__attribute__((target("avx2"), always_inline)) inline RayFields load_rays(const float* r) {
+  const __m256 r0 = _mm256_loadu_ps(r), r1 = _mm256_loadu_ps(r + 8), r2 = _mm256_loadu_ps(r + 16),
+               r3 = _mm256_loadu_ps(r + 24);
+  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+  const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+  return {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xee), _mm256_shuffle_ps(t1, t3, 0x44),
+          _mm256_shuffle_ps(t1, t3, 0xee)};
+}
+// The lane of each ray after load_rays, for _mm256_permutevar8x32_ps back into ray order.
+__attribute__((target("avx2"), always_inline)) inline __m256i ray_order() {
+  return _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
+}
+
+// crossing() for eight rays a register: the walk runs until every lane has crossed or left the
+// range, a lane that is done keeping its result. Only AVX2 (no FMA): a fused multiply-add would
+// round differently from the scalar search.
+__attribute__((target("avx2"))) void crossings_avx2(const float* rays, int count, float* out, const float* values,
+                                                    const float* bounds, int width, int height, int bound_width,
+                                                    float front_value, float back_value) {
+  const __m256 front = _mm256_set1_ps(front_value), back = _mm256_set1_ps(back_value);
+  const __m256 range = _mm256_sub_ps(front, back);
+  const __m256 size_x = _mm256_set1_ps(static_cast<float>(width)), size_y = _mm256_set1_ps(static_cast<float>(height));
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.f), tiny = _mm256_set1_ps(1.0e-30f);
+  const __m256 sign = _mm256_set1_ps(-0.f);
+  const __m256i last_x = _mm256_set1_epi32(width - 1), last_y = _mm256_set1_epi32(height - 1);
+  const __m256i row = _mm256_set1_epi32(width);
+  int i = 0;
+  for (; i + 8 <= count; i += 8) {
+    const auto [u, v, gain_u, gain_v] = load_rays(rays + 4 * static_cast<std::size_t>(i));
+    const __m256 start_x = _mm256_mul_ps(_mm256_add_ps(u, _mm256_mul_ps(gain_u, front)), size_x);
+    const __m256 start_y = _mm256_mul_ps(_mm256_add_ps(v, _mm256_mul_ps(gain_v, front)), size_y);
+    const __m256 speed_x = _mm256_mul_ps(_mm256_xor_ps(gain_u, sign), size_x);
+    const __m256 speed_y = _mm256_mul_ps(_mm256_xor_ps(gain_v, sign), size_y);
+    const __m256i tile_x = _mm256_srai_epi32(clamp_index(floor_index(start_x), last_x), 3);
+    const __m256i tile_y = _mm256_srai_epi32(clamp_index(floor_index(start_y), last_y), 3);
+    const __m256 bound = _mm256_i32gather_ps(
+        bounds, _mm256_add_epi32(_mm256_mullo_epi32(tile_y, _mm256_set1_epi32(bound_width)), tile_x), 4);
+    const __m256 abs_x = _mm256_andnot_ps(sign, speed_x), abs_y = _mm256_andnot_ps(sign, speed_y);
+    const __m256 fastest = _mm256_max_ps(_mm256_max_ps(abs_x, abs_y), tiny);
+    __m256 t =
+        _mm256_min_ps(_mm256_min_ps(_mm256_sub_ps(front, bound),
+                                    _mm256_div_ps(_mm256_set1_ps(static_cast<float>(depth_bound_tile - 1)), fastest)),
+                      range);
+    const __m256 p_x = _mm256_add_ps(start_x, _mm256_mul_ps(speed_x, t));
+    const __m256 p_y = _mm256_add_ps(start_y, _mm256_mul_ps(speed_y, t));
+    __m256i texel_x = floor_index(p_x), texel_y = floor_index(p_y);
+    const __m256 below_x = _mm256_cvtepi32_ps(texel_x), below_y = _mm256_cvtepi32_ps(texel_y);
+    const __m256 forward_x = _mm256_cmp_ps(speed_x, zero, _CMP_GT_OQ),
+                 forward_y = _mm256_cmp_ps(speed_y, zero, _CMP_GT_OQ);
+    const __m256 backward_x = _mm256_cmp_ps(speed_x, zero, _CMP_LT_OQ),
+                 backward_y = _mm256_cmp_ps(speed_y, zero, _CMP_LT_OQ);
+    // step: 1 forward, -1 backward, 0 still (the masks are all ones, i.e. -1, where true).
+    const __m256i step_x = _mm256_sub_epi32(_mm256_castps_si256(backward_x), _mm256_castps_si256(forward_x));
+    const __m256i step_y = _mm256_sub_epi32(_mm256_castps_si256(backward_y), _mm256_castps_si256(forward_y));
+    const __m256 delta_x = _mm256_div_ps(one, _mm256_max_ps(abs_x, tiny));
+    const __m256 delta_y = _mm256_div_ps(one, _mm256_max_ps(abs_y, tiny));
+    __m256 next_x =
+        _mm256_add_ps(t, _mm256_mul_ps(_mm256_blendv_ps(_mm256_sub_ps(p_x, below_x),
+                                                        _mm256_sub_ps(_mm256_add_ps(below_x, one), p_x), forward_x),
+                                       delta_x));
+    __m256 next_y =
+        _mm256_add_ps(t, _mm256_mul_ps(_mm256_blendv_ps(_mm256_sub_ps(p_y, below_y),
+                                                        _mm256_sub_ps(_mm256_add_ps(below_y, one), p_y), forward_y),
+                                       delta_y));
+    __m256 result = back;
+    __m256 active = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    for (int k = 0; k < depth_search_texels && _mm256_movemask_ps(active) != 0; ++k) {
+      const __m256 t_next = _mm256_min_ps(_mm256_min_ps(next_x, next_y), range);
+      const __m256i index =
+          _mm256_add_epi32(_mm256_mullo_epi32(clamp_index(texel_y, last_y), row), clamp_index(texel_x, last_x));
+      const __m256 value = _mm256_mask_i32gather_ps(zero, values, index, active, 4);
+      const __m256 done = _mm256_cmp_ps(t_next, range, _CMP_GE_OQ);
+      const __m256 leave = _mm256_blendv_ps(_mm256_sub_ps(front, t_next), back, done);
+      const __m256 crossed = _mm256_and_ps(active, _mm256_cmp_ps(value, leave, _CMP_GE_OQ));
+      result = _mm256_blendv_ps(result, _mm256_min_ps(value, _mm256_sub_ps(front, t)), crossed);
+      active = _mm256_andnot_ps(_mm256_or_ps(crossed, done), active);
+      // Along x where next_x < next_y, else along y.
+      const __m256 along_x = _mm256_cmp_ps(next_x, next_y, _CMP_LT_OQ);
+      const __m256i x_mask = _mm256_castps_si256(along_x);
+      texel_x = _mm256_add_epi32(texel_x, _mm256_and_si256(step_x, x_mask));
+      texel_y = _mm256_add_epi32(texel_y, _mm256_andnot_si256(x_mask, step_y));
+      t = _mm256_blendv_ps(next_y, next_x, along_x);
+      next_x = _mm256_blendv_ps(next_x, _mm256_add_ps(next_x, delta_x), along_x);
+      next_y = _mm256_blendv_ps(_mm256_add_ps(next_y, delta_y), next_y, along_x);
+    }
+    _mm256_storeu_ps(out + i, _mm256_permutevar8x32_ps(result, ray_order()));
+  }
+}
+
+bool cpu_has_avx2() {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+}
+
+}  // namespace
+#endif
+
+void DisparitySurface::crossings(const float* rays, int count, float* out) const {
+  int i = 0;
+#if defined(NELF_DEPTH_AVX2)
+  if (cpu_has_avx2() && front_ > back_) {
+    i = count / 8 * 8;
+    crossings_avx2(rays, i, out, values_.data(), bounds_.data(), width_, height_, bound_width_, front_, back_);
+  }
+#endif
+  for (; i < count; ++i) out[i] = crossing(rays[4 * i], rays[4 * i + 1], rays[4 * i + 2], rays[4 * i + 3]);
 }
 
 }  // namespace nelf

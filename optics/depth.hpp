@@ -14,6 +14,7 @@
 // v + p δ/e, where δ is the disparity of the surface there: the view seen from a pupil point p is
 // the view from the centre shifted by p/e of its disparity (p = ±e is the other eye's view). The
 // front-most δ with δ = disparity(v + p δ/e) is where the ray meets the surface.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -74,6 +75,15 @@ class DisparitySurface {
   // bound holds for, whichever comes first: nothing before is near enough to cross it. A surface of
   // one value v gives flat_uv + gain · v exactly (0: flat_uv).
   Vec2 hit(Vec2 flat_uv, Vec2 gain) const;
+  // The same search in the shader's float arithmetic, step for step (shaders/depth_search.glsl's
+  // surface_hit), for the CPU depth-aware composite (compositor/cpu/composite_table.hpp): the δ / W
+  // where the ray (flat point (u, v), gain (gain_u, gain_v)) meets the surface. Inline: it is that
+  // path's inner loop.
+  float crossing(float u, float v, float gain_u, float gain_v) const;
+  // crossing() of `count` rays, each four floats in `rays` (u, v, gain_u, gain_v), into `out`: eight
+  // at a time with AVX2 where the CPU has it (the same operations in the same order, so the same
+  // values), one at a time elsewhere.
+  void crossings(const float* rays, int count, float* out) const;
 
  private:
   int width_ = 0, height_ = 0;
@@ -92,6 +102,56 @@ inline constexpr int depth_search_texels = 48;
 // bound a ray in front of a far region skips to it and crosses a texel or two, rather than walking
 // down from the front of the whole frame's range (docs/PERFORMANCE.md).
 inline constexpr int depth_bound_tile = 8;
+
+inline float DisparitySurface::crossing(float u, float v, float gain_u, float gain_v) const {
+  // GLSL's min and max (the second operand when the comparison fails), not std::fmin's NaN rules:
+  // those are a libm call each, which cost more than the rest of the walk.
+  const auto lesser = [](float a, float b) { return b < a ? b : a; };
+  const auto greater = [](float a, float b) { return a < b ? b : a; };
+  // floor as an int, for coordinates held where converting them is defined (far outside the map
+  // the walk clamps its texels into it anyway).
+  const auto floor_index = [](float p) {
+    p = p > -1e6f ? p : -1e6f;  // NaN too
+    p = p < 1e6f ? p : 1e6f;
+    const int i = static_cast<int>(p);
+    return static_cast<float>(i) > p ? i - 1 : i;
+  };
+  const float back = back_, front = front_;
+  if (!(front > back)) return front;
+  const float range = front - back;
+  const float size[2] = {static_cast<float>(width_), static_cast<float>(height_)};
+  const float start[2] = {(u + gain_u * front) * size[0], (v + gain_v * front) * size[1]};
+  const float speed[2] = {-gain_u * size[0], -gain_v * size[1]};
+  const int tile_x = std::clamp(floor_index(start[0]), 0, width_ - 1) / depth_bound_tile;
+  const int tile_y = std::clamp(floor_index(start[1]), 0, height_ - 1) / depth_bound_tile;
+  const float bound = bounds_[static_cast<std::size_t>(tile_y) * bound_width_ + tile_x];
+  const float fastest = greater(greater(std::fabs(speed[0]), std::fabs(speed[1])), 1.0e-30f);
+  float t = lesser(lesser(front - bound, static_cast<float>(depth_bound_tile - 1) / fastest), range);
+  int texel[2], step[2];
+  float delta[2], next[2];
+  for (int a = 0; a < 2; ++a) {
+    const float p = start[a] + speed[a] * t;
+    texel[a] = floor_index(p);
+    const float below = static_cast<float>(texel[a]);
+    step[a] = speed[a] > 0.f ? 1 : speed[a] < 0.f ? -1 : 0;
+    delta[a] = 1.0f / greater(std::fabs(speed[a]), 1.0e-30f);
+    next[a] = t + (speed[a] > 0.f ? below + 1.0f - p : p - below) * delta[a];
+  }
+  const float* values = values_.data();
+  for (int i = 0; i < depth_search_texels; ++i) {
+    const float t_next = lesser(lesser(next[0], next[1]), range);
+    const float value = values[static_cast<std::size_t>(std::clamp(texel[1], 0, height_ - 1)) * width_ +
+                               std::clamp(texel[0], 0, width_ - 1)];
+    const float leave = t_next >= range ? back : front - t_next;
+    if (value >= leave) return lesser(value, front - t);
+    if (t_next >= range) break;
+    const int a = next[0] < next[1] ? 0 : 1;
+    texel[a] += step[a];
+    t = next[a];
+    next[a] += delta[a];
+  }
+  return back;
+}
 
 // The uv shift per unit of δ / W of a ray crossing the pupil plane at `pupil_mm`: (p_x / e, −p_y W / (e H)).
 Vec2 pupil_gain(const DepthGeometry& g, Vec2 pupil_mm);

@@ -3,13 +3,13 @@
 // optics/mapping.cpp (view_coordinate) in float. Pixel positions are taken relative to the
 // panel's pixel grid, so float keeps sub-micrometre precision.
 //
-// Compiled in seven variants (compositor/gl/shader_programs.cpp lists them, and the build validates
+// Compiled in eight variants (compositor/gl/shader_programs.cpp lists them, and the build validates
 // each): as is for pass 1 (point samples over the whole region), with NELF_AREA_SAMPLE for the
 // border strips, NELF_COORDINATE_MAP for pass 1's coordinate map, NELF_AREA_SAMPLE +
 // NELF_RECORD_TAPS for the CPU composite table, NELF_DEPTH (with or without NELF_AREA_SAMPLE)
 // for pass 1 and the strips of the depth-aware composite, NELF_DEPTH_MAP for its pass 1's
-// depth coordinate map (elemental_depth_lookup.frag), and NELF_AREA_SAMPLE + NELF_DEPTH_HITS for
-// the strips after that pass 1. Compile-time switches: llvmpipe would otherwise evaluate both sides
+// depth coordinate map (elemental_depth_lookup.frag), NELF_AREA_SAMPLE + NELF_DEPTH_HITS for
+// the strips after that pass 1, and those + NELF_RECORD_TAPS for the CPU depth-aware table. Compile-time switches: llvmpipe would otherwise evaluate both sides
 // of a run-time choice for every pixel.
 //
 // Memory layout: row 0 of the target region is the top row of the eye image (as in nelf::Image);
@@ -42,14 +42,15 @@ out vec4 colour;
 layout(binding = 3) uniform sampler2D u_hits;  // R32F, panel-sized, written by elemental_depth_lookup.frag
 vec2 g_lattice_position;                       // of the fragment's centre: area_sample's q (one sample)
 
-float hit_through(ivec2 lens) {
+// The pixel whose crossing the part through `lens` takes (u_hits is panel-sized).
+ivec2 hit_pixel(ivec2 lens) {
   const vec2 own = floor(g_lattice_position + 0.5);
   const vec2 across = vec2(lens) - own;  // -1, 0 or 1 per axis
   const vec2 one_pixel = u_pixel_pitch * u_to_lens_plane / u_lens_pitch;  // in lattice units
   const vec2 beyond = mix(g_lattice_position, own + across * (0.5 + one_pixel), notEqual(across, vec2(0.0)));
-  const ivec2 size = textureSize(u_hits, 0);
-  return texelFetch(u_hits, clamp(ivec2(floor(lattice_to_pixel(beyond))), ivec2(0), size - 1), 0).r;
+  return clamp(ivec2(floor(lattice_to_pixel(beyond))), ivec2(0), ivec2(u_panel) - 1);
 }
+float hit_through(ivec2 lens) { return texelFetch(u_hits, hit_pixel(lens), 0).r; }
 #endif
 
 bool inside(vec2 uv) { return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0))); }
@@ -71,7 +72,7 @@ bool lens_coordinate(vec2 s, ivec2 lens, out vec2 uv) {
   uv = vec2((v.x - u_screen_centre.x) / u_screen_size.x + 0.5, 0.5 - (v.y - u_screen_centre.y) / u_screen_size.y);
 #ifdef NELF_DEPTH
   uv = surface_uv(uv, (c - (s - c) * u_pupil_per_lens) * u_parallax_gain);
-#elif defined(NELF_DEPTH_HITS)
+#elif defined(NELF_DEPTH_HITS) && !defined(NELF_RECORD_TAPS)
   uv += (c - (s - c) * u_pupil_per_lens) * u_parallax_gain * hit_through(lens);
 #endif
   return true;
@@ -98,12 +99,22 @@ vec3 point_sample(vec2 pixel) {
 // Where each part of a border pixel taps u_view and with what weight (x, y, weight, 1), instead of
 // tapping: the CPU composite table (compositor/cpu/composite_table.hpp) replays them every frame.
 // Part 0 is the own lens, 1 the neighbour across x, 2 across y, 3 the diagonal one; weight 0 for a
-// part that is absent or falls on a black lens.
+// part that is absent or falls on a black lens. With NELF_DEPTH_HITS (the depth-aware table), what
+// of each part's ray does not change from frame to frame instead: u_part 0–3 its flat-screen point
+// and pupil crossing (as the depth coordinate map holds them), 4–7 its weight and the pixel whose
+// crossing it takes (x, y).
+layout(location = 0) uniform int u_part;
 vec4 recorded[4] = vec4[4](vec4(0.0, 0.0, 0.0, 1.0), vec4(0.0, 0.0, 0.0, 1.0), vec4(0.0, 0.0, 0.0, 1.0),
                            vec4(0.0, 0.0, 0.0, 1.0));
 void add_part(inout vec3 sum, int part, float weight, vec2 s, ivec2 lens) {
   vec2 uv;
-  if (lens_coordinate(s, lens, uv)) recorded[part] = vec4(uv * u_texture_scale + u_texture_offset, weight, 1.0);
+  if (!lens_coordinate(s, lens, uv)) return;
+#ifdef NELF_DEPTH_HITS
+  const vec2 c = u_lattice_offset + rotate(vec2(lens) * u_lens_pitch, 1.0);
+  recorded[part] = u_part < 4 ? vec4(uv, c - (s - c) * u_pupil_per_lens) : vec4(weight, vec2(hit_pixel(lens)), 1.0);
+#else
+  recorded[part] = vec4(uv * u_texture_scale + u_texture_offset, weight, 1.0);
+#endif
 }
 #else
 void add_part(inout vec3 sum, int part, float weight, vec2 s, ivec2 lens) { sum += weight * through_lens(s, lens); }
@@ -153,12 +164,11 @@ vec3 area_sample(vec2 pixel, float aperture) {
 
 #if defined(NELF_RECORD_TAPS)
 // The border strips' part u_part for the CPU composite table (one sub-sample per pixel); alpha 1
-// marks the pixels the strips cover (the target is cleared to 0). One part per pass keeps the
-// target a single panel-sized texture.
-layout(location = 0) uniform int u_part;
+// marks the pixels the strips cover (the target is cleared to 0; with NELF_DEPTH_HITS in passes
+// 4–7). One part per pass keeps the target a single panel-sized texture.
 void main() {
   area_sample(floor(gl_FragCoord.xy - u_region_origin) + 0.5, 1.0);
-  colour = recorded[u_part];
+  colour = recorded[u_part & 3];
 }
 #elif defined(NELF_DEPTH_MAP)
 // The depth coordinate map (one sample per pixel, lens arrays only): for each pixel, where its chief

@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "compositor/overlays/calibration_overlay.hpp"
+#include "optics/depth.hpp"
 
 namespace nelf {
 
@@ -160,8 +161,20 @@ bool CompositeAhead::composite(const CompositeSetup& setup, const StereoVideoFra
   for (std::size_t i = 0; i < 2; ++i)
     views[i] = covered_view(i == 0 ? frame.left : frame.right, setup.grid ? &(*setup.grid)[i] : nullptr,
                             setup.message.get(), views_[i]);
+  // The frame's depth as the display's thread takes it (FrameCompositor::update_depth): unusable
+  // depth is the flat screen.
+  std::array<std::optional<DisparitySurface>, 2> surfaces;
+  if (setup.depth && frame.disparity) {
+    try {
+      surfaces[0].emplace(frame.disparity->left);
+      surfaces[1].emplace(frame.disparity->right);
+    } catch (const std::invalid_argument&) {
+      surfaces = {};
+    }
+  }
+  const auto surface = [&](int i) { return surfaces[i] && surfaces[1 - i] ? &*surfaces[i] : nullptr; };
   render_packed_frame(*setup.tables, views, static_cast<std::size_t>(texture_w) * 4, setup.swap_eyes, setup.origins,
-                      setup.packed, out);
+                      setup.packed, out, {surface(0), surface(1)});
   compensate_packed_eyes(setup.defects, setup.origins, out.pixels.data(), static_cast<std::size_t>(setup.packed[0]) * 4,
                          8);
   return true;
@@ -191,7 +204,7 @@ const std::uint8_t* covered_view(std::span<const std::uint8_t> view, const Image
 void render_packed_frame(std::array<std::optional<CompositeTable>, 2>& tables,
                          const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride, bool swap_eyes,
                          const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::array<int, 2> packed,
-                         PackedFrameBytes& out) {
+                         PackedFrameBytes& out, const std::array<const DisparitySurface*, 2>& surfaces) {
   const std::size_t stride = static_cast<std::size_t>(packed[0]) * 4;
   const std::size_t size = stride * static_cast<std::size_t>(packed[1]);
   if (out.pixels.size() != size || out.packed != packed || out.origins != origins) {
@@ -202,7 +215,7 @@ void render_packed_frame(std::array<std::optional<CompositeTable>, 2>& tables,
   }
   const int swap = swap_eyes ? 1 : 0;
   render_packed_eyes(tables, {views[swap], views[1 - swap]}, view_stride, origins, out.pixels.data(), stride,
-                     ChannelOrder::bgra);
+                     ChannelOrder::bgra, {surfaces[swap], surfaces[1 - swap]});
 }
 
 }  // namespace nelf

@@ -60,6 +60,10 @@ struct CompositeSetup {
   std::shared_ptr<const Image> message;
   // The dead and stuck pixels hidden after compositing, per eye (plans for BGRA bytes), or none.
   EyeDefectPlans defects;
+  // Frames that carry their depth are composited with it (the tables hold the depth-aware rays,
+  // CompositeTable::has_depth); a frame whose depth is unusable shows the flat screen, as on the
+  // display's thread.
+  bool depth = false;
 };
 
 // The bytes a view is composited from: `view` itself, or, with a calibration `grid` or a `message`
@@ -79,12 +83,13 @@ struct PackedFrameBytes {
 
 // Both eyes through `tables` into `out` (made packed[0] × packed[1] and black around the panels
 // first, when its layout is another): eye e renders views[e ^ swap_eyes] (8-bit block means,
-// `view_stride` bytes a row) with its panel's top-left corner at origins[e]. What the worker and
-// the display's thread both do with a frame on the CPU path.
+// `view_stride` bytes a row) with its panel's top-left corner at origins[e], where its ray meets
+// surfaces[e ^ swap_eyes] (that view's depth; null: the flat screen). What the worker and the
+// display's thread both do with a frame on the CPU path.
 void render_packed_frame(std::array<std::optional<CompositeTable>, 2>& tables,
                          const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride, bool swap_eyes,
                          const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::array<int, 2> packed,
-                         PackedFrameBytes& out);
+                         PackedFrameBytes& out, const std::array<const DisparitySurface*, 2>& surfaces = {});
 
 class CompositeAhead {
   using Bytes = PackedFrameBytes;

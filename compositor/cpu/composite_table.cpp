@@ -7,6 +7,8 @@
 #include <future>
 #include <stdexcept>
 
+#include "optics/depth.hpp"
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -244,13 +246,43 @@ CompositeTable::Built CompositeTable::build(const Recording& r) {
     }
     b.borders.push_back(pixel);
   }
+  if (r.depth) {
+    const Recording::DepthRecording& d = *r.depth;
+    if (d.rays.size() != 4 * pixels || d.border_parts.size() != r.border_pixels.size())
+      throw std::invalid_argument("CompositeTable: the depth recording is inconsistent");
+    DepthTable depth;
+    depth.texture_scale = d.texture_scale;
+    depth.texture_offset = d.texture_offset;
+    // The gain per ray as the shader forms it: crossing × u_parallax_gain, in float.
+    const auto ray = [&](float u, float v, float crossing_x, float crossing_y) {
+      return DepthRay{u, v, crossing_x * d.parallax_gain[0], crossing_y * d.parallax_gain[1]};
+    };
+    depth.rays.reserve(pixels);
+    for (std::size_t i = 0; i < pixels; ++i)
+      depth.rays.push_back(ray(d.rays[4 * i], d.rays[4 * i + 1], d.rays[4 * i + 2], d.rays[4 * i + 3]));
+    depth.borders.reserve(r.border_pixels.size());
+    for (std::size_t i = 0; i < r.border_pixels.size(); ++i) {
+      DepthBorderPixel pixel;
+      pixel.x = r.border_pixels[i] % r.panel[0];
+      pixel.y = r.border_pixels[i] / r.panel[0];
+      for (int k = 0; k < 4; ++k) {
+        const Recording::DepthPart& part = d.border_parts[i][k];
+        pixel.weights[k] = part.weight;
+        if (part.weight <= 0.f) continue;
+        pixel.rays[k] = ray(part.u, part.v, part.crossing_x, part.crossing_y);
+        pixel.hit_pixels[k] = part.hit_pixel;
+      }
+      depth.borders.push_back(pixel);
+    }
+    b.depth = std::move(depth);
+  }
   return b;
 }
 
 CompositeTable::CompositeTable(const Recording& recording) : CompositeTable(build(recording)) {}
 
 CompositeTable::CompositeTable(Built built) : built_(std::move(built)) {
-  const auto& [panel, reduced, prefiltered, horizontal, vertical, taps, borders] = built_;
+  const auto& [panel, reduced, prefiltered, horizontal, vertical, taps, borders, depth] = built_;
   // Sizes whose products (pixels, texels, bytes) cannot overflow.
   const auto size_fits = [](std::array<int, 2> size) {
     return size[0] > 0 && size[1] > 0 && size[0] <= (1 << 15) && size[1] <= (1 << 15);
@@ -284,6 +316,29 @@ CompositeTable::CompositeTable(Built built) : built_(std::move(built)) {
       !std::is_sorted(borders.begin(), borders.end(),
                       [](const BorderPixel& a, const BorderPixel& b) { return a.y < b.y; }))
     throw std::invalid_argument("CompositeTable: the table is inconsistent");
+  if (depth) {
+    // Rays and gains finite (the tap clamps any finite coordinate into the image), each border part
+    // taking the crossing of a pixel of the panel.
+    const auto finite = [](const DepthRay& r) {
+      return std::isfinite(r.u) && std::isfinite(r.v) && std::isfinite(r.gain_u) && std::isfinite(r.gain_v);
+    };
+    const std::int64_t pixels = std::int64_t{panel[0]} * panel[1];
+    const auto depth_border_fits = [&](const DepthBorderPixel& b) {
+      for (int k = 0; k < 4; ++k)
+        if (!std::isfinite(b.weights[k]) || !finite(b.rays[k]) || b.hit_pixels[k] < 0 || b.hit_pixels[k] >= pixels)
+          return false;
+      return b.x >= 0 && b.x < panel[0] && b.y >= 0 && b.y < panel[1];
+    };
+    if (depth->rays.size() != taps.size() || !std::all_of(depth->rays.begin(), depth->rays.end(), finite) ||
+        !std::all_of(depth->borders.begin(), depth->borders.end(), depth_border_fits) ||
+        !std::all_of(depth->texture_scale.begin(), depth->texture_scale.end(),
+                     [](float v) { return std::isfinite(v); }) ||
+        !std::all_of(depth->texture_offset.begin(), depth->texture_offset.end(),
+                     [](float v) { return std::isfinite(v); }))
+      throw std::invalid_argument("CompositeTable: the table's depth rays are inconsistent");
+    hits_.assign(depth->rays.size(), 0.f);
+    row_taps_.resize(static_cast<std::size_t>(panel[0]));
+  }
 
   // The box pass in fixed point. Along x every output sample takes the same number of cell pairs
   // (zero weights pad the shorter ones; the input row has that many spare cells), and the outputs
@@ -329,11 +384,18 @@ CompositeTable::Tap CompositeTable::make_tap(float u, float v, std::array<int, 2
   // GL_LINEAR with GL_CLAMP_TO_EDGE: texel centres at (i + ½) / size; each of the four texels
   // clamped into the texture on its own.
   const double size[2] = {static_cast<double>(prefiltered[0]), static_cast<double>(prefiltered[1])};
-  const double coordinate[2] = {u * size[0] - 0.5, v * size[1] - 0.5};
+  double coordinate[2] = {u * size[0] - 0.5, v * size[1] - 0.5};
   int lo[2];
   double fraction[2];
   for (int a = 0; a < 2; ++a) {
-    const int i = static_cast<int>(std::floor(coordinate[a]));
+    // Held within a texel of the image (whatever the coordinate: a depth-aware tap's may be
+    // anything finite, or not), where converting it to int is defined and the clamps below give
+    // what they would; floor without a libm call (this runs per pixel per frame with depth).
+    double& c = coordinate[a];
+    c = c > -2.0 ? c : -2.0;
+    c = c < size[a] + 1.0 ? c : size[a] + 1.0;
+    const int truncated = static_cast<int>(c);
+    const int i = truncated > c ? truncated - 1 : truncated;
     const int last = prefiltered[a] - 1;
     lo[a] = std::clamp(i, 0, last);
     // Clamped at the edge both texels are the same one: all the weight on the first.
@@ -345,7 +407,7 @@ CompositeTable::Tap CompositeTable::make_tap(float u, float v, std::array<int, 2
                            (1 - fraction[0]) * fraction[1], fraction[0] * fraction[1]};
   int weights[4], total = 0, largest = 0;
   for (int k = 0; k < 4; ++k) {
-    weights[k] = static_cast<int>(std::lround(exact[k] * 256.0));
+    weights[k] = static_cast<int>(exact[k] * 256.0 + 0.5);  // lround: exact ≥ 0
     total += weights[k];
     if (exact[k] > exact[largest]) largest = k;
   }
@@ -576,8 +638,14 @@ void CompositeTable::box_pass(const std::uint8_t* reduced, std::size_t reduced_s
 }
 
 void CompositeTable::render(const std::uint8_t* reduced, std::size_t reduced_stride, std::uint8_t* out,
-                            std::size_t out_stride, ChannelOrder order) {
+                            std::size_t out_stride, ChannelOrder order, const DisparitySurface* surface) {
+  if (surface && !built_.depth)
+    throw std::logic_error("CompositeTable::render: a surface given to a table recorded without depth");
   box_pass(reduced, reduced_stride, order);
+  if (surface) {
+    render_depth(*surface, out, out_stride);
+    return;
+  }
 
   // Pass 1, one bilinear tap per pixel, a row at a time; then pass 2 for the row's pixels along the
   // elemental-image borders (sorted by row) while the row is still in the cache.
@@ -593,6 +661,177 @@ void CompositeTable::render(const std::uint8_t* reduced, std::size_t reduced_str
   }
 }
 
+namespace {
+
+// make_tap in float and without branches on the data, for the depth-aware pass's taps (made per
+// pixel per frame; make_tap's double arithmetic and its branches cost as much as the search). The
+// same rounding: each product in 8 bits, the largest taking the rest. GL's clamp to edge at the
+// image's sides (its margin is black there), any coordinate (NaN and infinities too) held inside.
+inline CompositeTable::Tap depth_tap(float u, float v, int width, int height) {
+  const auto axis = [](float coordinate, int size, int& lo) {
+    float c = coordinate * static_cast<float>(size) - 0.5f;
+    c = c > -1.f ? c : -1.f;
+    c = c < static_cast<float>(size) ? c : static_cast<float>(size);
+    const int i = static_cast<int>(c + 1.f) - 1;  // floor, c ≥ -1
+    lo = i < 0 ? 0 : i < size - 1 ? i : size - 1;
+    return i >= 0 && i < size - 1 ? c - static_cast<float>(i) : 0.f;
+  };
+  int lo_x, lo_y;
+  const float fx = axis(u, width, lo_x), fy = axis(v, height, lo_y);
+  const float e0 = (1.f - fx) * (1.f - fy), e1 = fx * (1.f - fy), e2 = (1.f - fx) * fy, e3 = fx * fy;
+  const int w0 = static_cast<int>(e0 * 256.f + 0.5f), w1 = static_cast<int>(e1 * 256.f + 0.5f),
+            w2 = static_cast<int>(e2 * 256.f + 0.5f), w3 = static_cast<int>(e3 * 256.f + 0.5f);
+  // The largest product (the first of equals, as make_tap) takes what rounding left over.
+  const int a = e1 > e0 ? 1 : 0, b = e3 > e2 ? 3 : 2;
+  const float ea = a ? e1 : e0, eb = b == 3 ? e3 : e2;
+  const int largest = eb > ea ? b : a;
+  const int rest = 256 - (w0 + w1 + w2 + w3);
+  // The four weights as one word (bytes in tap order), built in registers: writing a Tap's bytes
+  // one by one and reading the Tap back as 8 bytes stalls on store forwarding.
+  const std::uint32_t word = static_cast<std::uint32_t>(w0) | static_cast<std::uint32_t>(w1) << 8 |
+                             static_cast<std::uint32_t>(w2) << 16 | static_cast<std::uint32_t>(w3) << 24;
+  const std::uint32_t fixed = word + (static_cast<std::uint32_t>(rest) << (8 * largest));
+  const int top = static_cast<int>((fixed >> (8 * largest)) & 0xffu);
+  // All the weight on one texel (the byte wrapped to 0 from 256): that texel's tap alone.
+  const bool alone = top == 0 && ((largest == 0 ? w0 : largest == 1 ? w1 : largest == 2 ? w2 : w3) + rest) == 256;
+  const std::int32_t offset = largest == 0 ? 0 : largest == 1 ? 1 : largest == 2 ? width : width + 1;
+  CompositeTable::Tap tap;
+  tap.texel = lo_y * width + lo_x + (alone ? offset : 0);
+  const std::uint32_t weights = alone ? 0u : fixed;
+  std::memcpy(tap.weights.data(), &weights, 4);
+  return tap;
+}
+
+#if defined(NELF_TABLE_AVX2)
+// One axis of depth_tap() for eight coordinates: the clamped first texel and the fraction towards
+// the next (0 where they coincide).
+__attribute__((target("avx2"), always_inline)) inline __m256 depth_tap_axis(__m256 coordinate, float scale,
+                                                                            float offset, int size, __m256i& lo) {
+  const __m256 size_f = _mm256_set1_ps(static_cast<float>(size));
+  __m256 c = _mm256_sub_ps(
+      _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(coordinate, _mm256_set1_ps(scale)), _mm256_set1_ps(offset)), size_f),
+      _mm256_set1_ps(0.5f));
+  c = _mm256_max_ps(c, _mm256_set1_ps(-1.f));  // NaN to -1, as c > -1 ? c : -1
+  c = _mm256_min_ps(c, size_f);                // as c < size ? c : size
+  const __m256i i = _mm256_sub_epi32(_mm256_cvttps_epi32(_mm256_add_ps(c, _mm256_set1_ps(1.f))), _mm256_set1_epi32(1));
+  const __m256i zero = _mm256_setzero_si256(), last = _mm256_set1_epi32(size - 1);
+  lo = _mm256_min_epi32(_mm256_max_epi32(i, zero), last);
+  const __m256i inside = _mm256_andnot_si256(_mm256_cmpgt_epi32(zero, i), _mm256_cmpgt_epi32(last, i));
+  return _mm256_and_ps(_mm256_sub_ps(c, _mm256_cvtepi32_ps(i)), _mm256_castsi256_ps(inside));
+}
+// A product's 8-bit weight, rounded half up (e ≥ 0).
+__attribute__((target("avx2"), always_inline)) inline __m256i depth_tap_weight(__m256 e) {
+  return _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(e, _mm256_set1_ps(256.f)), _mm256_set1_ps(0.5f)));
+}
+
+// depth_tap() for eight rays a register (the same operations, so the same taps), black rays (u <
+// -1e8) the `black` texel alone; writes count / 8 * 8 taps and returns how many.
+__attribute__((target("avx2"))) int depth_taps_avx2(const CompositeTable::DepthRay* rays, const float* hits, int count,
+                                                    std::array<float, 2> scale, std::array<float, 2> offsets, int width,
+                                                    int height, std::int32_t black, CompositeTable::Tap* out) {
+  const __m256i lanes = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
+  const __m256 one = _mm256_set1_ps(1.f);
+  const __m256i w_vector = _mm256_set1_epi32(width);
+  int x = 0;
+  for (; x + 8 <= count; x += 8) {
+    const float* r = &rays[x].u;
+    const __m256 u = _mm256_i32gather_ps(r, lanes, 4), v = _mm256_i32gather_ps(r + 1, lanes, 4);
+    const __m256 gain_u = _mm256_i32gather_ps(r + 2, lanes, 4), gain_v = _mm256_i32gather_ps(r + 3, lanes, 4);
+    const __m256 hit = _mm256_loadu_ps(hits + x);
+    __m256i lo_x, lo_y;
+    const __m256 fx = depth_tap_axis(_mm256_add_ps(u, _mm256_mul_ps(gain_u, hit)), scale[0], offsets[0], width, lo_x);
+    const __m256 fy = depth_tap_axis(_mm256_add_ps(v, _mm256_mul_ps(gain_v, hit)), scale[1], offsets[1], height, lo_y);
+    const __m256 gx = _mm256_sub_ps(one, fx), gy = _mm256_sub_ps(one, fy);
+    const __m256 e0 = _mm256_mul_ps(gx, gy), e1 = _mm256_mul_ps(fx, gy), e2 = _mm256_mul_ps(gx, fy),
+                 e3 = _mm256_mul_ps(fx, fy);
+    const __m256i w0 = depth_tap_weight(e0), w1 = depth_tap_weight(e1), w2 = depth_tap_weight(e2),
+                  w3 = depth_tap_weight(e3);
+    // The largest (the first of equals): a of the first pair, b of the second, then between them.
+    const __m256 a_is_1 = _mm256_cmp_ps(e1, e0, _CMP_GT_OQ), b_is_3 = _mm256_cmp_ps(e3, e2, _CMP_GT_OQ);
+    const __m256 ea = _mm256_blendv_ps(e0, e1, a_is_1), eb = _mm256_blendv_ps(e2, e3, b_is_3);
+    const __m256 b_wins = _mm256_cmp_ps(eb, ea, _CMP_GT_OQ);
+    const __m256i a = _mm256_and_si256(_mm256_castps_si256(a_is_1), _mm256_set1_epi32(1));
+    const __m256i b =
+        _mm256_add_epi32(_mm256_set1_epi32(2), _mm256_and_si256(_mm256_castps_si256(b_is_3), _mm256_set1_epi32(1)));
+    const __m256i largest =
+        _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(a), _mm256_castsi256_ps(b), b_wins));
+    const __m256i wa = _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(w0), _mm256_castsi256_ps(w1), a_is_1));
+    const __m256i wb = _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(w2), _mm256_castsi256_ps(w3), b_is_3));
+    const __m256i w_largest =
+        _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(wa), _mm256_castsi256_ps(wb), b_wins));
+    const __m256i rest =
+        _mm256_sub_epi32(_mm256_set1_epi32(256), _mm256_add_epi32(_mm256_add_epi32(w0, w1), _mm256_add_epi32(w2, w3)));
+    const __m256i word = _mm256_or_si256(_mm256_or_si256(w0, _mm256_slli_epi32(w1, 8)),
+                                         _mm256_or_si256(_mm256_slli_epi32(w2, 16), _mm256_slli_epi32(w3, 24)));
+    const __m256i fixed = _mm256_add_epi32(word, _mm256_sllv_epi32(rest, _mm256_slli_epi32(largest, 3)));
+    const __m256i alone = _mm256_cmpeq_epi32(_mm256_add_epi32(w_largest, rest), _mm256_set1_epi32(256));
+    // The offset of texel `largest` from the first: 0, 1, a row, a row and one.
+    const __m256i offset = _mm256_add_epi32(_mm256_and_si256(largest, _mm256_set1_epi32(1)),
+                                            _mm256_mullo_epi32(_mm256_srli_epi32(largest, 1), w_vector));
+    __m256i texel =
+        _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(lo_y, w_vector), lo_x), _mm256_and_si256(offset, alone));
+    __m256i weights = _mm256_andnot_si256(alone, fixed);
+    const __m256i dark = _mm256_castps_si256(_mm256_cmp_ps(u, _mm256_set1_ps(-1.0e8f), _CMP_LT_OQ));
+    texel = _mm256_blendv_epi8(texel, _mm256_set1_epi32(black), dark);
+    weights = _mm256_andnot_si256(dark, weights);
+    // Interleaved as taps (texel, weights): lanes 0 1 4 5 in `low`, 2 3 6 7 in `high`.
+    const __m256i low = _mm256_unpacklo_epi32(texel, weights), high = _mm256_unpackhi_epi32(texel, weights);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + x), _mm256_permute2x128_si256(low, high, 0x20));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + x + 4), _mm256_permute2x128_si256(low, high, 0x31));
+  }
+  return x;
+}
+#endif
+
+}  // namespace
+
+// The depth-aware composite (shaders/elemental_depth_lookup.frag, then the border strips of
+// elemental.frag with NELF_DEPTH_HITS): per pixel the search for where its ray meets the surface and
+// one tap there, made as a tap of the flat table (make_tap) and replayed a row at a time with the
+// same arithmetic; then the border pixels, each part through its lens where its ray meets the
+// surface at the crossing its hit pixel found. Pass 1 goes first over all rows: a part may take a
+// crossing from the row below.
+void CompositeTable::render_depth(const DisparitySurface& surface, std::uint8_t* out, std::size_t out_stride) {
+  const DepthTable& depth = *built_.depth;
+  const std::uint8_t* image = image_.data();
+  const std::size_t image_row = static_cast<std::size_t>(built_.prefiltered[0]) * 4;
+  const int width = built_.panel[0];
+  const auto [scale_u, scale_v] = depth.texture_scale;
+  const auto [offset_u, offset_v] = depth.texture_offset;
+  const int image_w = built_.prefiltered[0], image_h = built_.prefiltered[1];
+  const CompositeTable::Tap black = make_tap(-1.f, -1.f, built_.prefiltered);
+  const auto tap_at = [&](const DepthRay& ray, float hit) {
+    return depth_tap((ray.u + ray.gain_u * hit) * scale_u + offset_u, (ray.v + ray.gain_v * hit) * scale_v + offset_v,
+                     image_w, image_h);
+  };
+  static_assert(sizeof(DepthRay) == 4 * sizeof(float), "a row of rays is four floats a ray");
+  for (int y = 0; y < built_.panel[1]; ++y) {
+    const std::size_t first = static_cast<std::size_t>(y) * width;
+    // The row's searches at once (black pixels too, without a branch: their result is dropped).
+    surface.crossings(&depth.rays[first].u, width, &hits_[first]);
+    int x = 0;
+#if defined(NELF_TABLE_AVX2)
+    if (has_avx2())
+      x = depth_taps_avx2(&depth.rays[first], &hits_[first], width, depth.texture_scale, depth.texture_offset, image_w,
+                          image_h, black.texel, row_taps_.data());
+#endif
+    for (; x < width; ++x) {
+      const DepthRay& ray = depth.rays[first + x];
+      // A black pixel of the display: the black texel (its crossing, as GL's, is kept for the strips).
+      row_taps_[x] = ray.u < -1.0e8f ? black : tap_at(ray, hits_[first + x]);
+    }
+    replay_taps(row_taps_.data(), width, image, image_row, out + static_cast<std::size_t>(y) * out_stride);
+  }
+  for (const DepthBorderPixel& b : depth.borders) {
+    BorderPixel pixel;
+    pixel.weights = b.weights;
+    for (int k = 0; k < 4; ++k)
+      if (b.weights[k] > 0.f) pixel.taps[k] = tap_at(b.rays[k], hits_[static_cast<std::size_t>(b.hit_pixels[k])]);
+    border_pixel(pixel, image, image_row,
+                 out + static_cast<std::size_t>(b.y) * out_stride + 4 * static_cast<std::size_t>(b.x));
+  }
+}
+
 void fill_opaque_black(std::span<std::uint8_t> rgba) {
   const std::uint8_t black[4] = {0, 0, 0, 255};
   for (std::size_t i = 0; i + 4 <= rgba.size(); i += 4) std::memcpy(&rgba[i], black, 4);
@@ -601,13 +840,14 @@ void fill_opaque_black(std::span<std::uint8_t> rgba) {
 void render_packed_eyes(std::array<std::optional<CompositeTable>, 2>& tables,
                         const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride,
                         const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::uint8_t* packed,
-                        std::size_t stride, ChannelOrder order) {
+                        std::size_t stride, ChannelOrder order,
+                        const std::array<const DisparitySurface*, 2>& surfaces) {
   const auto render_eye = [&](int e) {
     if (!origins[e] || !tables[e]) return;
     tables[e]->render(views[e], view_stride,
                       packed + static_cast<std::size_t>(origins[e]->second) * stride +
                           static_cast<std::size_t>(origins[e]->first) * 4,
-                      stride, order);
+                      stride, order, surfaces[e]);
   };
   auto right = std::async(std::launch::async, render_eye, 1);
   render_eye(0);

@@ -22,6 +22,8 @@
 
 namespace nelf {
 
+class DisparitySurface;  // optics/depth.hpp
+
 // The byte order of a table's output pixels. The block means are always RGBA8; BGRA is what X11
 // and DRM framebuffers hold, so a packed frame made in it goes to the screen by plain copies (on
 // llvmpipe a 1:1 blit between the same formats is a memcpy, a swizzling one a shader pass).
@@ -56,6 +58,23 @@ class CompositeTable {
     // each its four parts: texture coordinate and weight (0: absent, or a black lens).
     std::vector<std::int32_t> border_pixels;
     std::vector<std::array<BorderPart, 4>> border_parts;
+    // The depth-aware composite's rays (recorded with CompositorOptions::depth on, lens arrays
+    // only), for frames that carry their depth: what of each ray does not change from frame to
+    // frame, as GL's depth coordinate map and its border strips (elemental.frag, NELF_DEPTH_MAP and
+    // NELF_DEPTH_HITS) hold it.
+    struct DepthPart {
+      float u = 0.f, v = 0.f;                    // where the part's ray meets the flat screen (uv)
+      float crossing_x = 0.f, crossing_y = 0.f;  // where it crosses the pupil plane (mm)
+      float weight = 0.f;                        // 0: absent, or a black lens
+      std::int32_t hit_pixel = 0;                // the pixel whose crossing it takes (y · panel[0] + x)
+    };
+    struct DepthRecording {
+      std::vector<float> rays;  // panel[0]·panel[1]·4: flat-screen uv, pupil crossing (mm); u < -1e8 black
+      std::vector<std::array<DepthPart, 4>> border_parts;  // per border pixel, as border_parts
+      std::array<float, 2> parallax_gain{0.f, 0.f};        // uv shift per mm of crossing per unit of δ / W
+      std::array<float, 2> texture_scale{1.f, 1.f}, texture_offset{0.f, 0.f};  // uv → prefiltered texture
+    };
+    std::optional<DepthRecording> depth;
   };
 
   // One bilinear tap of the prefiltered image: its top-left texel (y · prefiltered[0] + x; the
@@ -74,11 +93,28 @@ class CompositeTable {
   };
   // What render() replays, built from a Recording (what a CompositeTableCache keeps: a table loaded
   // from it needs no make_tap per pixel).
+  // A ray of the depth-aware composite: where it meets the flat screen (uv; u < -1e8: a black
+  // pixel) and its uv shift per unit of δ / W (the pupil crossing times the parallax gain).
+  struct DepthRay {
+    float u = 0.f, v = 0.f, gain_u = 0.f, gain_v = 0.f;
+  };
+  struct DepthBorderPixel {
+    std::int32_t x = 0, y = 0;  // in the panel
+    std::array<DepthRay, 4> rays;
+    std::array<float, 4> weights{};            // per part; ≤ 0: no part
+    std::array<std::int32_t, 4> hit_pixels{};  // per part, the pixel whose crossing it takes
+  };
+  struct DepthTable {
+    std::vector<DepthRay> rays;             // per pixel (pass 1)
+    std::vector<DepthBorderPixel> borders;  // pass 2
+    std::array<float, 2> texture_scale{1.f, 1.f}, texture_offset{0.f, 0.f};
+  };
   struct Built {
     std::array<int, 2> panel{0, 0}, reduced{0, 0}, prefiltered{0, 0};  // as in Recording
     BoxAxis horizontal, vertical;
     std::vector<Tap> taps;             // per pixel, y · panel[0] + x (pass 1)
     std::vector<BorderPixel> borders;  // pass 2, in row order
+    std::optional<DepthTable> depth;   // the depth-aware composite's rays, when recorded
   };
 
   explicit CompositeTable(const Recording& recording);
@@ -91,12 +127,17 @@ class CompositeTable {
   std::array<int, 2> reduced_size() const { return built_.reduced; }
   const Built& built() const { return built_; }
 
+  // Whether the table holds the depth-aware composite's rays (render() with a surface).
+  bool has_depth() const { return built_.depth.has_value(); }
+
   // Renders the eye from `reduced` (RGBA8 block means, row 0 the top row, `reduced_stride` bytes
   // per row) into `out` (the panel-sized eye image, 8 bits a channel in `order`, row 0 the top row,
-  // `out_stride` bytes per row; alpha 255). Not thread-safe on one table (scratch buffers); use one
-  // per thread.
+  // `out_stride` bytes per row; alpha 255). With a `surface` (the view's depth; the table must
+  // have_depth()), each pixel shows the view where its ray meets that surface, as GL's depth-aware
+  // pass does (the search in the shader's float arithmetic, DisparitySurface::crossing); without,
+  // the flat screen. Not thread-safe on one table (scratch buffers); use one per thread.
   void render(const std::uint8_t* reduced, std::size_t reduced_stride, std::uint8_t* out, std::size_t out_stride,
-              ChannelOrder order = ChannelOrder::rgba);
+              ChannelOrder order = ChannelOrder::rgba, const DisparitySurface* surface = nullptr);
 
  private:
   // The box pass in fixed point: per output sample of an axis, pairs of input cells with their
@@ -113,6 +154,7 @@ class CompositeTable {
   static void replay_taps(const Tap* taps, int count, const std::uint8_t* image, std::size_t image_row,
                           std::uint8_t* out);
   void box_pass(const std::uint8_t* reduced, std::size_t reduced_stride, ChannelOrder order);
+  void render_depth(const DisparitySurface& surface, std::uint8_t* out, std::size_t out_stride);
 
   Built built_;
   FixedAxis horizontal_, vertical_;
@@ -120,6 +162,8 @@ class CompositeTable {
   std::vector<std::uint8_t> across_;  // after the horizontal pass: across_row_ bytes × reduced[1] rows
   std::size_t across_row_ = 0;
   std::vector<std::uint8_t> image_;  // the prefiltered image: prefiltered[0] × prefiltered[1], RGBA8, spare rows
+  std::vector<float> hits_;          // with depth: each pixel's crossing, δ / W (the border parts take them)
+  std::vector<Tap> row_taps_;        // with depth: one row's taps, made per frame
 };
 
 // Opaque black RGBA8 (0, 0, 0, 255) over `rgba` (a whole number of pixels): what surrounds the
@@ -131,9 +175,11 @@ void fill_opaque_black(std::span<std::uint8_t> rgba);
 // is ready sooner): eye e, when it has a table and an origin, renders views[e] (block means,
 // `view_stride` bytes a row) with its panel's top-left corner at origins[e] (x, y). Pixels outside
 // the panels are left as they are.
+// `surfaces`: per eye, the depth its view shows (render()'s surface), or null for the flat screen.
 void render_packed_eyes(std::array<std::optional<CompositeTable>, 2>& tables,
                         const std::array<const std::uint8_t*, 2>& views, std::size_t view_stride,
                         const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::uint8_t* packed,
-                        std::size_t stride, ChannelOrder order = ChannelOrder::rgba);
+                        std::size_t stride, ChannelOrder order = ChannelOrder::rgba,
+                        const std::array<const DisparitySurface*, 2>& surfaces = {});
 
 }  // namespace nelf

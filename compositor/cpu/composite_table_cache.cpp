@@ -12,15 +12,16 @@
 #include <type_traits>
 #include <vector>
 
-#include "core/embedded.hpp"
 #include "compositor/gl/gl_compositor.hpp"
+#include "core/embedded.hpp"
 
 namespace nelf {
 
 namespace {
 
-// Version 2 holds the built table (taps, not texture coordinates), so a load skips make_tap.
-constexpr char kMagic[8] = {'N', 'E', 'L', 'F', 'C', 'T', '2', '\n'};
+// Version 2 holds the built table (taps, not texture coordinates), so a load skips make_tap;
+// version 3 the depth-aware composite's rays after it (a flag, then those where it is 1).
+constexpr char kMagic[8] = {'N', 'E', 'L', 'F', 'C', 'T', '3', '\n'};
 constexpr std::uint64_t kMaxElements = std::uint64_t{1} << 28;  // far beyond any panel
 
 std::uint64_t fnv1a(const std::string& text) {
@@ -120,11 +121,12 @@ std::string composite_table_key(const Profile& profile, const CompositorOptions&
                                 int view_height, double aspect, std::array<int, 2> block) {
   // The shaders that record the table are part of the key: a changed shader is a new table.
   std::string shaders;
-  for (const char* name : {"elemental.frag", "border_strips.vert", "fullscreen.vert"})
+  for (const char* name : {"elemental.frag", "border_strips.vert", "fullscreen.vert", "mapping.glsl"})
     shaders += std::string(embedded::find(embedded::nelf_embedded_shaders(), name).value_or(""));
-  return fmt::format("nelf {}\nfsaa {} eye {} view {}x{} aspect {:.17g} block {}x{}\nshaders {:016x}\n{}", NELF_VERSION,
-                     options.fsaa, static_cast<int>(eye), view_width, view_height, aspect, block[0], block[1],
-                     fnv1a(shaders), profile_to_toml(profile));
+  // With depth on, the table holds the depth-aware rays as well (any mode: they do not depend on it).
+  return fmt::format("nelf {}\nfsaa {} eye {} view {}x{} aspect {:.17g} block {}x{} depth rays {}\nshaders {:016x}\n{}",
+                     NELF_VERSION, options.fsaa, static_cast<int>(eye), view_width, view_height, aspect, block[0],
+                     block[1], options.depth != DepthMode::off ? 1 : 0, fnv1a(shaders), profile_to_toml(profile));
 }
 
 std::filesystem::path CompositeTableCache::path_for(const std::string& key) const {
@@ -146,6 +148,15 @@ std::optional<CompositeTable> CompositeTableCache::load(const std::string& key) 
       !read_axis(r, built.horizontal) || !read_axis(r, built.vertical) || !r.vector(built.taps) ||
       !r.vector(built.borders))
     return std::nullopt;
+  std::uint8_t has_depth = 0;
+  if (!r.value(has_depth) || has_depth > 1) return std::nullopt;
+  if (has_depth) {
+    CompositeTable::DepthTable depth;
+    if (!r.vector(depth.rays) || !r.vector(depth.borders) || !r.value(depth.texture_scale) ||
+        !r.value(depth.texture_offset))
+      return std::nullopt;
+    built.depth = std::move(depth);
+  }
   try {
     return CompositeTable(std::move(built));  // which checks everything that indexes memory
   } catch (const std::exception&) {           // inconsistent, or sizes too large to allocate
@@ -174,6 +185,13 @@ bool CompositeTableCache::store(const std::string& key, const CompositeTable& ta
     write_axis(w, built.vertical);
     w.vector(built.taps);
     w.vector(built.borders);
+    w.value(static_cast<std::uint8_t>(built.depth ? 1 : 0));
+    if (built.depth) {
+      w.vector(built.depth->rays);
+      w.vector(built.depth->borders);
+      w.value(built.depth->texture_scale);
+      w.value(built.depth->texture_offset);
+    }
     out.flush();
     if (!out) {
       out.close();

@@ -406,6 +406,48 @@ std::optional<CompositeTable::Recording> GlCompositor::record_composite_table(Ey
         r.border_parts[b][k] = {p[0], p[1], p[2]};
       }
     }
+    // The depth-aware composite's rays, for frames that carry their depth: the depth coordinate map
+    // (pass 1's flat points and pupil crossings) and, from the depth strips, each border part's ray
+    // and the pixel whose crossing it takes (two passes a part: 0–3, then 4–7).
+    if (options_.depth != DepthMode::off) {
+      CompositeTable::Recording::DepthRecording d;
+      const Vec2 gain = pupil_gain(depth_geometry(profile_, m), {1.0, 1.0});
+      d.parallax_gain = {f(gain.x), f(gain.y)};
+      d.texture_scale = {texture.scale[0], texture.scale[1]};
+      d.texture_offset = {texture.offset[0], texture.offset[1]};
+      CoordinateMap rays;
+      draw_depth_map(m, rays);
+      d.rays.resize(4 * pixels);
+      glGetTextureImage(rays.texture.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(d.rays.size() * sizeof(float)),
+                        d.rays.data());
+      const GLuint record = program(shaders::ProgramKind::depth_record);
+      glProgramUniform1f(record, shaders::location::depth::pupil_per_lens, f(m.eye_relief_mm / m.gap_mm));
+      upload_mapping(m, texture, 0, 0);
+      glBindVertexArray(empty_vertex_array_.id());
+      glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+      glViewport(0, 0, width, height);
+      glUseProgram(record);
+      d.border_parts.resize(r.border_pixels.size());
+      for (int k = 0; k < 8; ++k) {
+        const GLfloat zero[4] = {0.f, 0.f, 0.f, 0.f};
+        glClearNamedFramebufferfv(fbo.id(), GL_COLOR, 0, zero);
+        glProgramUniform1i(record, shaders::location::record_part, k);
+        glDrawArrays(GL_TRIANGLES, 0, 6 * (m.lenses[0] + m.lenses[1] + 2));
+        glGetTextureImage(part_texture.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(part.size() * sizeof(float)),
+                          part.data());
+        for (std::size_t b = 0; b < r.border_pixels.size(); ++b) {
+          const float* p = &part[4 * static_cast<std::size_t>(r.border_pixels[b])];
+          CompositeTable::Recording::DepthPart& to = d.border_parts[b][k & 3];
+          if (k < 4) {
+            to.u = p[0], to.v = p[1], to.crossing_x = p[2], to.crossing_y = p[3];
+          } else {
+            to.weight = p[0];
+            to.hit_pixel = static_cast<std::int32_t>(p[2]) * width + static_cast<std::int32_t>(p[1]);
+          }
+        }
+      }
+      r.depth = std::move(d);
+    }
   }
   gl::check_error("recording the composite table");
   return r;

@@ -116,6 +116,8 @@ class GlCompositor final : public Compositor {
   // recorded with this compositor's shaders. Nothing where no table applies: fsaa other than 1,
   // no prefilter, or `block` not prefilter_block() of the view. Replaying it on the CPU is much
   // cheaper than render_eye_reduced on a software rasteriser; on a GPU render_eye_reduced wins.
+  // With options().depth on and a lens array, the table holds the depth-aware composite's rays too
+  // (CompositeTable::has_depth), so that frames with depth take the CPU path as well.
   std::optional<CompositeTable> make_composite_table(Eye eye, int view_width, int view_height, double aspect,
                                                      std::array<int, 2> block);
   // What make_composite_table builds the table from.

@@ -37,6 +37,8 @@ std::string_view kind_name(ProgramKind kind) {
       return "depth_lookup";
     case ProgramKind::depth_border_hits:
       return "depth_border_hits";
+    case ProgramKind::depth_record:
+      return "depth_record";
     case ProgramKind::defect_gather:
       return "defect_gather";
     case ProgramKind::defect_apply:
@@ -85,6 +87,9 @@ ProgramSource program_source(ProgramKind kind, int subsamples) {
       return {"fullscreen.vert", "elemental_depth_lookup.frag", {}};
     case ProgramKind::depth_border_hits:
       return {"border_strips.vert", "elemental.frag", "#define NELF_AREA_SAMPLE 1\n#define NELF_DEPTH_HITS 1\n"};
+    case ProgramKind::depth_record:
+      return {"border_strips.vert", "elemental.frag",
+              "#define NELF_AREA_SAMPLE 1\n#define NELF_DEPTH_HITS 1\n#define NELF_RECORD_TAPS 1\n"};
     case ProgramKind::defect_gather:
       return {"defect_gather.vert", "defect_gather.frag", {}};
     case ProgramKind::defect_apply:

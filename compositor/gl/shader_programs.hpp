@@ -24,6 +24,7 @@ enum class ProgramKind {
   depth_map,          // its pass 1's depth coordinate map (fsaa 1): each pixel's flat-screen point and pupil crossing
   depth_lookup,       // its pass 1 from the depth coordinate map: the search and one tap per pixel
   depth_border_hits,  // its border strips after depth_lookup: each part takes a crossing pass 1 found
+  depth_record,       // those strips' rays and borrowed crossings, written down for the CPU depth-aware table
   defect_gather,      // defect compensation, pass 1: what each defect was sent, less what it shows
   defect_apply,       // its pass 2: each pixel's shares added to the frame
 };
@@ -41,6 +42,7 @@ inline constexpr std::array every_program_kind = {
     ProgramKind::depth_map,
     ProgramKind::depth_lookup,
     ProgramKind::depth_border_hits,
+    ProgramKind::depth_record,
     ProgramKind::defect_gather,
     ProgramKind::defect_apply,
 };

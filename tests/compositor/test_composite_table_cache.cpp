@@ -6,12 +6,16 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <limits>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "compositor/cpu/composite_table_cache.hpp"
+#include "optics/depth.hpp"
 #include "support/test_support.hpp"
 
 namespace nelf {
@@ -30,6 +34,29 @@ CompositeTable::Recording small_recording() {
   return r;
 }
 
+// small_recording() with the depth-aware rays: pixel 2 black, the border parts taking pixel 0's
+// and pixel 4's crossings.
+CompositeTable::Recording small_depth_recording() {
+  CompositeTable::Recording r = small_recording();
+  CompositeTable::Recording::DepthRecording d;
+  d.rays = {0.1f, 0.2f, 1.f, 0.f, 0.3f, 0.4f, -1.f, 0.5f, -1e9f, -1e9f, 0.f, 0.f,
+            0.5f, 0.5f, 0.f, 1.f, 0.6f, 0.7f, 2.f,  -1.f, 0.8f,  0.9f,  0.f, 0.f};
+  d.border_parts = {{{{0.1f, 0.2f, 1.f, 0.f, 0.75f, 0}, {0.3f, 0.4f, -1.f, 0.f, 0.25f, 4}, {}, {}}},
+                    {{{0.5f, 0.5f, 0.f, 1.f, 1.f, 4}, {}, {}, {}}}};
+  d.parallax_gain = {0.02f, -0.03f};
+  d.texture_scale = {0.5f, 0.5f};
+  d.texture_offset = {0.25f, 0.25f};
+  r.depth = d;
+  return r;
+}
+
+// A rough surface for the small tables: values from behind the screen to in front of it.
+DisparitySurface small_surface() {
+  ViewDisparity d{8, 6, std::vector<float>(48)};
+  for (std::size_t i = 0; i < d.d.size(); ++i) d.d[i] = static_cast<float>(static_cast<int>(i * 7 % 11) - 4);
+  return DisparitySurface(d);
+}
+
 // A small image to render: RGBA8 block means, `size` of them.
 std::vector<std::uint8_t> test_means(std::array<int, 2> size) {
   std::vector<std::uint8_t> means(static_cast<std::size_t>(size[0]) * size[1] * 4);
@@ -37,12 +64,12 @@ std::vector<std::uint8_t> test_means(std::array<int, 2> size) {
   return means;
 }
 
-std::vector<std::uint8_t> rendered(CompositeTable& table) {
+std::vector<std::uint8_t> rendered(CompositeTable& table, const DisparitySurface* surface = nullptr) {
   const auto panel = table.panel();
   std::vector<std::uint8_t> out(static_cast<std::size_t>(panel[0]) * panel[1] * 4, 0);
   const auto means = test_means(table.reduced_size());
   table.render(means.data(), static_cast<std::size_t>(table.reduced_size()[0]) * 4, out.data(),
-               static_cast<std::size_t>(panel[0]) * 4);
+               static_cast<std::size_t>(panel[0]) * 4, ChannelOrder::rgba, surface);
   return out;
 }
 
@@ -86,6 +113,42 @@ TEST(CompositeTableCache, StoredTableComesBackWholeUnderItsKeyOnly) {
   EXPECT_EQ(test::files_in(dir / "tables").size(), 1u);
 }
 
+TEST(CompositeTableCache, DepthRaysComeBackAndRenderTheSame) {
+  test::TempDir dir;
+  const CompositeTableCache cache(dir.path());
+  CompositeTable table(small_depth_recording());
+  ASSERT_TRUE(table.has_depth());
+  ASSERT_TRUE(cache.store("depth", table));
+  auto loaded = cache.load("depth");
+  ASSERT_TRUE(loaded);
+  ASSERT_TRUE(loaded->has_depth());
+  expect_same(*loaded, table);
+  const DisparitySurface surface = small_surface();
+  EXPECT_EQ(rendered(*loaded, &surface), rendered(table, &surface));
+  EXPECT_NE(rendered(table, &surface), rendered(table)) << "the surface must move what the rays show";
+  // A table without the rays stays without them.
+  ASSERT_TRUE(cache.store("flat", CompositeTable(small_recording())));
+  EXPECT_FALSE(cache.load("flat")->has_depth());
+}
+
+TEST(CompositeTableCache, InconsistentDepthRaysAreRefused) {
+  const auto refused = [](const std::function<void(CompositeTable::Built&)>& damage) {
+    CompositeTable::Built built = CompositeTable(small_depth_recording()).built();
+    damage(built);
+    EXPECT_THROW(CompositeTable{std::move(built)}, std::invalid_argument);
+  };
+  refused([](auto& b) { b.depth->rays.pop_back(); });
+  refused([](auto& b) { b.depth->rays[1].gain_u = std::numeric_limits<float>::infinity(); });
+  refused([](auto& b) { b.depth->rays[3].v = std::numeric_limits<float>::quiet_NaN(); });
+  refused([](auto& b) { b.depth->borders[0].hit_pixels[1] = 6; });  // past the 3×2 panel
+  refused([](auto& b) { b.depth->borders[0].hit_pixels[0] = -1; });
+  refused([](auto& b) { b.depth->borders[1].x = 3; });
+  refused([](auto& b) { b.depth->texture_scale[0] = std::numeric_limits<float>::quiet_NaN(); });
+  CompositeTable::Recording mismatched = small_depth_recording();
+  mismatched.depth->border_parts.pop_back();
+  EXPECT_THROW(CompositeTable{mismatched}, std::invalid_argument);
+}
+
 TEST(CompositeTableCache, DamagedEntriesAreNotUsed) {
   test::TempDir dir;
   const CompositeTableCache cache(dir.path());
@@ -125,6 +188,12 @@ TEST(CompositeTableCache, KeyNamesWhatTheTableDependsOn) {
   EXPECT_NE(key, composite_table_key(hmz, fsaa1, Eye::left, 1920, 1080, 16.0 / 9.0, {2, 4}));
   EXPECT_NE(key, composite_table_key(hmz, fsaa1, Eye::left, 960, 1080, 4.0 / 3.0, {2, 4}));
   EXPECT_NE(key, composite_table_key(shifted, fsaa1, Eye::left, 960, 1080, 16.0 / 9.0, {2, 4}));
+  // With depth on the table holds the depth-aware rays too; which mode does not matter.
+  const CompositorOptions estimate{1, std::nullopt, DepthMode::estimate},
+      automatic{1, std::nullopt, DepthMode::automatic};
+  const std::string depth_key = composite_table_key(hmz, estimate, Eye::left, 960, 1080, 16.0 / 9.0, {2, 4});
+  EXPECT_NE(key, depth_key);
+  EXPECT_EQ(depth_key, composite_table_key(hmz, automatic, Eye::left, 960, 1080, 16.0 / 9.0, {2, 4}));
 }
 
 TEST(CompositeTableCache, DefaultDirectoryFollowsTheEnvironment) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "optics/depth.hpp"
 
@@ -124,6 +125,44 @@ TEST(DisparitySurface, TheCrossingIsWhereTheRayMeetsTheTexels) {
   const Vec2 diagonal = s.hit({0.41, 0.55}, {-0.5, -0.5});
   EXPECT_NEAR(diagonal.x, 0.40, 1e-12);
   EXPECT_NEAR(diagonal.y, 0.55 - 0.5 * 0.02, 1e-12);
+}
+
+// The float search (the shader's, for the CPU depth-aware composite) finds what the double one
+// does, and the batched search (AVX2 eight rays at a time where the CPU has it) exactly what the
+// one-ray float search does, for rays across a rough surface and rays far outside the map.
+TEST(DisparitySurface, FloatAndBatchedSearchesAgreeWithTheDoubleOne) {
+  const int w = 96, h = 54;
+  ViewDisparity d{w, h, std::vector<float>(static_cast<std::size_t>(w) * h)};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      d.d[static_cast<std::size_t>(y) * w + x] =
+          (x / 7 + y / 5) % 3 == 0 ? 9.f : static_cast<float>(3.0 * std::sin(0.3 * x) * std::cos(0.2 * y));
+  const DisparitySurface s(d);
+  std::vector<float> rays;
+  std::uint32_t state = 12345;
+  const auto random = [&](float lo, float hi) {
+    state = state * 1664525u + 1013904223u;
+    return lo + (hi - lo) * static_cast<float>(state >> 8) / static_cast<float>(1u << 24);
+  };
+  for (int i = 0; i < 1003; ++i) {  // not a multiple of eight: the batch's tail too
+    const bool far = i % 50 == 0;
+    rays.insert(rays.end(), {far ? random(-40.f, 40.f) : random(0.f, 1.f), random(0.f, 1.f), random(-0.3f, 0.3f),
+                             random(-0.3f, 0.3f)});
+  }
+  const int count = static_cast<int>(rays.size() / 4);
+  std::vector<float> batched(static_cast<std::size_t>(count));
+  s.crossings(rays.data(), count, batched.data());
+  int differ_from_double = 0;
+  for (int i = 0; i < count; ++i) {
+    const float* r = &rays[4 * static_cast<std::size_t>(i)];
+    const float one = s.crossing(r[0], r[1], r[2], r[3]);
+    ASSERT_EQ(batched[static_cast<std::size_t>(i)], one) << "ray " << i;
+    const Vec2 exact = s.hit({r[0], r[1]}, {r[2], r[3]});
+    const double exact_hit = r[2] != 0.f ? (exact.x - r[0]) / r[2] : 0.0;
+    differ_from_double += std::abs(exact_hit - one) > 1e-3 ? 1 : 0;
+  }
+  // Float and double part only at a tie between two texels' crossings.
+  EXPECT_LE(differ_from_double, count / 100);
 }
 
 // A tile's front bound is the nearest value of it and its eight neighbours, and no farther.

@@ -80,6 +80,17 @@ double max_abs_difference(const Image& a, const Image& b) {
   return worst;
 }
 
+std::shared_ptr<const DisparitySurface> near_block_surface(const Profile& profile, double aspect, int width,
+                                                           int height) {
+  const EyeMapping m = make_eye_mapping(profile, Eye::left, aspect);
+  const DepthGeometry g = depth_geometry(profile, m);
+  const float near_px = static_cast<float>(disparity_mm_from_depth(g, 250.0) / g.screen_size_mm.x * width);
+  ViewDisparity d{width, height, std::vector<float>(static_cast<std::size_t>(width) * height, 0.f)};
+  for (int y = height / 4; y < 3 * height / 4; ++y)
+    for (int x = width / 6; x < width / 2; ++x) d.d[static_cast<std::size_t>(y) * width + x] = near_px;
+  return std::make_shared<const DisparitySurface>(d);
+}
+
 Profile small_panel_profile() {
   return parse_profile(R"(
 name = "hmz-t1-small"

@@ -9,6 +9,7 @@
 
 #include "core/gl/egl_context.hpp"
 #include "core/image.hpp"
+#include "optics/depth.hpp"
 #include "optics/profile.hpp"
 
 namespace nelf::test {
@@ -30,6 +31,12 @@ double max_abs_difference(const Image& a, const Image& b);
 // hmz-t1 with a 320×180 panel of 4× the pixel pitch (same physical size and optics, 16× fewer
 // pixels), so the 16×16 reference stays fast.
 Profile small_panel_profile();
+
+// A width×height disparity surface for the left eye of `profile` and views shown at `aspect`: a
+// block over the left third of the view (x from 1/6 to 1/2, y from 1/4 to 3/4) at 250 mm, the rest
+// on the screen.
+std::shared_ptr<const DisparitySurface> near_block_surface(const Profile& profile, double aspect, int width,
+                                                           int height);
 
 // `view` averaged in `block` cells, RGBA8, as swscale's area filter hands them over.
 std::vector<std::uint8_t> block_means(const Image& view, std::array<int, 2> block);

@@ -20,17 +20,6 @@ Image gl_eye(const Profile& profile, int fsaa, const View& view, std::shared_ptr
   return compositor.compose({view, view})[static_cast<int>(eye)];
 }
 
-// The left third of the view near (250 mm), the rest on the screen (hmz-t1: 1 m): δ/W per texel.
-std::shared_ptr<const DisparitySurface> near_block(const Profile& profile, const View& view, int width, int height) {
-  const EyeMapping m = make_eye_mapping(profile, Eye::left, view.aspect());
-  const DepthGeometry g = depth_geometry(profile, m);
-  const float near_px = static_cast<float>(disparity_mm_from_depth(g, 250.0) / g.screen_size_mm.x * width);
-  ViewDisparity d{width, height, std::vector<float>(static_cast<std::size_t>(width) * height, 0.f)};
-  for (int y = height / 4; y < 3 * height / 4; ++y)
-    for (int x = width / 6; x < width / 2; ++x) d.d[static_cast<std::size_t>(y) * width + x] = near_px;
-  return std::make_shared<const DisparitySurface>(d);
-}
-
 TEST(DepthComposite, AFlatSurfaceRendersExactlyWhatNoSurfaceDoes) {
   const Profile profile = test::small_panel_profile();
   const View view{test::photo_chart(480, 270), 0.0};
@@ -46,7 +35,7 @@ TEST(DepthComposite, AFlatSurfaceRendersExactlyWhatNoSurfaceDoes) {
 TEST(DepthComposite, GlMatchesTheDepthAwareReferenceAndDiffersFromTheFlatScreen) {
   const Profile profile = test::small_panel_profile();
   const View view{test::photo_chart(480, 270), 0.0};
-  const auto surface = near_block(profile, view, 240, 135);
+  const auto surface = test::near_block_surface(profile, view.aspect(), 240, 135);
   const EyeMapping m = make_eye_mapping(profile, Eye::left, view.aspect());
   const Image reference = reference_eye_image(m, view.image, *surface, depth_geometry(profile, m), 16);
   const Image flat_reference = reference_eye_image(m, view.image, 16);

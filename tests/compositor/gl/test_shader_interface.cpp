@@ -65,7 +65,7 @@ const std::vector<std::pair<const char*, std::size_t>>& mapping_members() {
 
 TEST(ShaderInterface, EveryMappingProgramHasTheBlockAsTheMirrorLaysItOut) {
   for (ProgramKind kind : {ProgramKind::elemental, ProgramKind::border, ProgramKind::map, ProgramKind::record,
-                           ProgramKind::depth, ProgramKind::depth_border}) {
+                           ProgramKind::depth, ProgramKind::depth_border, ProgramKind::depth_record}) {
     for (int subsamples : shaders::subsample_counts) {
       SCOPED_TRACE(testing::Message() << "program " << static_cast<int>(kind) << ", " << subsamples << " sub-samples");
       const gl::Program p = link(kind, subsamples);
@@ -129,6 +129,11 @@ TEST(ShaderInterface, UniformLocationsAndTextureUnitsAreTheDeclaredOnes) {
   EXPECT_EQ(glGetUniformLocation(strips_from_hits.id(), "u_parallax_gain"), at::depth::parallax_gain);
   EXPECT_EQ(glGetUniformLocation(strips_from_hits.id(), "u_pupil_per_lens"), at::depth::pupil_per_lens);
   EXPECT_EQ(sampler_unit(strips_from_hits.id(), "u_hits"), static_cast<GLint>(shaders::hits_unit));
+  const gl::Program depth_record = link(ProgramKind::depth_record);
+  EXPECT_EQ(glGetUniformLocation(depth_record.id(), "u_part"), at::record_part);
+  EXPECT_EQ(glGetUniformLocation(depth_record.id(), "u_pupil_per_lens"), at::depth::pupil_per_lens);
+  EXPECT_EQ(glGetUniformLocation(depth_record.id(), "u_view"), -1) << "the recording pass takes no tap";
+  EXPECT_EQ(glGetUniformLocation(depth_record.id(), "u_hits"), -1) << "it records which crossing, not the crossing";
 
   const gl::Program text = link(ProgramKind::text_overlay);
   EXPECT_EQ(glGetUniformLocation(text.id(), "u_box_origin"), at::text_box_origin);
