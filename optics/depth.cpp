@@ -176,6 +176,7 @@ __attribute__((target("avx2"), always_inline)) inline __m256i ray_order() {
 __attribute__((target("avx2"))) void crossings_avx2(const float* rays, int count, float* out, const float* values,
                                                     const float* bounds, int width, int height, int bound_width,
                                                     float front_value, float back_value) {
+  static_assert(depth_bound_tile == 8, "a tile index is the texel index shifted right by 3");
   const __m256 front = _mm256_set1_ps(front_value), back = _mm256_set1_ps(back_value);
   const __m256 range = _mm256_sub_ps(front, back);
   const __m256 size_x = _mm256_set1_ps(static_cast<float>(width)), size_y = _mm256_set1_ps(static_cast<float>(height));
