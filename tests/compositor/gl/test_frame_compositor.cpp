@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
@@ -350,6 +351,64 @@ TEST(FrameCompositor, FramesCompositedAheadIntoAGlTarget) {
   compositor.wait_for_ahead(std::chrono::milliseconds(5000));
   EXPECT_FALSE(compositor.render(first, {}, {target}));
   EXPECT_EQ(read_rgba(), render_bytes(compositor, first).rgba);
+}
+
+// test_frame() with depth: a block at 250 mm over the left third of both views, in pixels of a
+// 240×136 map (the disparity a source attaches).
+FrameCompositor::Frame depth_frame(const FrameCompositor& compositor, bool exchanged = false) {
+  auto frame = std::make_shared<StereoVideoFrame>(*test_frame(compositor, exchanged));
+  const int w = 240, h = 136;
+  const auto surface = test::near_block_surface(compositor.profile(), double(kViewW) / kViewH, w, h);
+  ViewDisparity map{w, h, std::vector<float>(static_cast<std::size_t>(w) * h)};
+  for (std::size_t i = 0; i < map.d.size(); ++i) map.d[i] = surface->values()[i] * static_cast<float>(w);
+  frame->disparity = std::make_shared<const StereoDisparity>(StereoDisparity{map, map, DisparityOrigin::estimated});
+  return frame;
+}
+
+// Frames with depth take the tables too (their depth-aware rays) and agree with GL's depth pass;
+// composited ahead (eyes exchanged: each eye's view keeps its own depth) they are what render makes.
+TEST(FrameCompositor, DepthFramesTakeTheTablesAgreeWithGlAndComeAhead) {
+  const Profile profile = test::small_panel_profile();
+  const PackedLayout layout = layout_for(profile, "hdmi-fp-720p60");
+  const CompositorOptions options{1, std::nullopt, DepthMode::automatic};
+  PackedFrame from_gl, from_tables, flat;
+  {
+    CompositeEnvironment gl("gl");
+    FrameCompositor compositor(profile, options, layout, test::shared_gl_context());
+    from_gl = render_bytes(compositor, depth_frame(compositor));
+    EXPECT_TRUE(compositor.depth_aware());
+  }
+  CompositeEnvironment table("table");
+  FrameCompositor compositor(profile, options, layout, test::shared_gl_context());
+  from_tables = render_bytes(compositor, depth_frame(compositor));
+  EXPECT_TRUE(compositor.depth_aware());
+  flat = render_bytes(compositor, test_frame(compositor));
+  EXPECT_FALSE(compositor.depth_aware());
+  expect_eyes_at_the_origins(from_tables, layout);
+  const Difference d = difference(from_gl.rgba, from_tables.rgba);
+  std::printf("depth frame, tables against GL: max %d, mean %.4f\n", d.max, d.mean);
+  EXPECT_LE(d.max, 3);
+  EXPECT_LT(d.mean, 0.1);
+  std::size_t moved = 0;
+  for (std::size_t i = 0; i < flat.rgba.size(); ++i) moved += std::abs(flat.rgba[i] - from_tables.rgba[i]) > 8 ? 1 : 0;
+  std::printf("the depth moves %.2f %% of the frame's channel values by more than 8\n",
+              100.0 * moved / flat.rgba.size());
+  EXPECT_GT(moved, flat.rgba.size() / 4000) << "the depth must move the picture (the eyes are 6 % of the frame)";
+
+  const gl::Texture texture = gl::make_texture_2d(GL_RGBA8, layout.packed[0], layout.packed[1]);
+  const gl::Framebuffer fbo = gl::make_framebuffer(texture);
+  const GlPackedTarget target{fbo.id(), texture.id(), layout.packed};
+  const FrameOverlays overlays{"", false, true};
+  const auto first = depth_frame(compositor), second = depth_frame(compositor, true);
+  EXPECT_FALSE(compositor.render(first, overlays, {target}));
+  compositor.composite_ahead(std::vector<FrameCompositor::Frame>{second}, overlays, target);
+  compositor.wait_for_ahead(std::chrono::milliseconds(5000));
+  EXPECT_TRUE(compositor.render(second, overlays, {target}));
+  Bytes shown(static_cast<std::size_t>(layout.packed[0]) * layout.packed[1] * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo.id());
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, layout.packed[0], layout.packed[1], GL_RGBA, GL_UNSIGNED_BYTE, shown.data());
+  EXPECT_EQ(shown, render_bytes(compositor, second, overlays).rgba);
 }
 
 TEST(FrameCompositor, StillsAreTheComposedEyesPackedBySignal) {
