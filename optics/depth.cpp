@@ -8,6 +8,8 @@
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
+
+#include "optics/ray_lanes_avx2.hpp"
 #define NELF_DEPTH_AVX2 1
 #endif
 
@@ -107,11 +109,15 @@ Vec2 DisparitySurface::hit(Vec2 flat_uv, Vec2 gain) const {
   // along an axis (a texel index moves by at most as much: the bound still holds), it is in front
   // of every texel it crosses. Out of the map its texels are the edge's (clamped), no farther away.
   const int size[2] = {width_, height_};
-  int tile[2];
+  int first[2];
   for (int a = 0; a < 2; ++a)
-    tile[a] = std::clamp(static_cast<int>(std::floor(start[a])), 0, size[a] - 1) / depth_bound_tile;
-  const double bound = bounds_[static_cast<std::size_t>(tile[1]) * bound_width_ + tile[0]];
+    first[a] = std::clamp(static_cast<int>(std::floor(std::clamp(start[a], -1e9, 1e9))), 0, size[a] - 1);
   const double fastest = std::max({std::abs(v[0]), std::abs(v[1]), 1e-30});
+  // A ray that does not move meets the surface in the texel it starts in (walking, it would never
+  // leave it).
+  if (!(fastest > 1e-30)) return along(values_[static_cast<std::size_t>(first[1]) * width_ + first[0]]);
+  const double bound =
+      bounds_[static_cast<std::size_t>(first[1] / depth_bound_tile) * bound_width_ + first[0] / depth_bound_tile];
   double t = std::min({front - bound, (depth_bound_tile - 1) / fastest, range});
   const double p[2] = {start[0] + v[0] * t, start[1] + v[1] * t};
   int texel[2], step[2];
@@ -151,25 +157,6 @@ __attribute__((target("avx2"), always_inline)) inline __m256i clamp_index(__m256
   return _mm256_min_epi32(_mm256_max_epi32(i, _mm256_setzero_si256()), last);
 }
 
-// Eight rays of four floats (u, v, gain_u, gain_v) as four registers of one field each, by a 4×4
-// transpose within each 128-bit half (gathers cost several times more on some CPUs). The lanes
-// then hold rays 0 2 4 6 1 3 5 7; ray_order puts results back in order.
-struct RayFields {
-  __m256 u, v, gain_u, gain_v;
-};
-__attribute__((target("avx2"), always_inline)) inline RayFields load_rays(const float* r) {
-  const __m256 r0 = _mm256_loadu_ps(r), r1 = _mm256_loadu_ps(r + 8), r2 = _mm256_loadu_ps(r + 16),
-               r3 = _mm256_loadu_ps(r + 24);
-  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
-  const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
-  return {_mm256_shuffle_ps(t0, t2, 0x44), _mm256_shuffle_ps(t0, t2, 0xee), _mm256_shuffle_ps(t1, t3, 0x44),
-          _mm256_shuffle_ps(t1, t3, 0xee)};
-}
-// The lane of each ray after load_rays, for _mm256_permutevar8x32_ps back into ray order.
-__attribute__((target("avx2"), always_inline)) inline __m256i ray_order() {
-  return _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
-}
-
 // crossing() for eight rays a register: the walk runs until every lane has crossed or left the
 // range, a lane that is done keeping its result. Only AVX2 (no FMA): a fused multiply-add would
 // round differently from the scalar search.
@@ -186,17 +173,20 @@ __attribute__((target("avx2"))) void crossings_avx2(const float* rays, int count
   const __m256i row = _mm256_set1_epi32(width);
   int i = 0;
   for (; i + 8 <= count; i += 8) {
-    const auto [u, v, gain_u, gain_v] = load_rays(rays + 4 * static_cast<std::size_t>(i));
+    const auto [u, v, gain_u, gain_v] = avx2::load_rays(rays + 4 * static_cast<std::size_t>(i));
     const __m256 start_x = _mm256_mul_ps(_mm256_add_ps(u, _mm256_mul_ps(gain_u, front)), size_x);
     const __m256 start_y = _mm256_mul_ps(_mm256_add_ps(v, _mm256_mul_ps(gain_v, front)), size_y);
     const __m256 speed_x = _mm256_mul_ps(_mm256_xor_ps(gain_u, sign), size_x);
     const __m256 speed_y = _mm256_mul_ps(_mm256_xor_ps(gain_v, sign), size_y);
-    const __m256i tile_x = _mm256_srai_epi32(clamp_index(floor_index(start_x), last_x), 3);
-    const __m256i tile_y = _mm256_srai_epi32(clamp_index(floor_index(start_y), last_y), 3);
+    const __m256i first_x = clamp_index(floor_index(start_x), last_x);
+    const __m256i first_y = clamp_index(floor_index(start_y), last_y);
+    const __m256i tile_x = _mm256_srai_epi32(first_x, 3), tile_y = _mm256_srai_epi32(first_y, 3);
     const __m256 bound = _mm256_i32gather_ps(
         bounds, _mm256_add_epi32(_mm256_mullo_epi32(tile_y, _mm256_set1_epi32(bound_width)), tile_x), 4);
     const __m256 abs_x = _mm256_andnot_ps(sign, speed_x), abs_y = _mm256_andnot_ps(sign, speed_y);
     const __m256 fastest = _mm256_max_ps(_mm256_max_ps(abs_x, abs_y), tiny);
+    // Rays that do not move (black pixels): the texel they start in, and no walk.
+    const __m256 still = _mm256_cmp_ps(fastest, tiny, _CMP_LE_OQ);
     __m256 t =
         _mm256_min_ps(_mm256_min_ps(_mm256_sub_ps(front, bound),
                                     _mm256_div_ps(_mm256_set1_ps(static_cast<float>(depth_bound_tile - 1)), fastest)),
@@ -223,7 +213,10 @@ __attribute__((target("avx2"))) void crossings_avx2(const float* rays, int count
                                                         _mm256_sub_ps(_mm256_add_ps(below_y, one), p_y), forward_y),
                                        delta_y));
     __m256 result = back;
-    __m256 active = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    if (_mm256_movemask_ps(still) != 0)
+      result =
+          _mm256_mask_i32gather_ps(back, values, _mm256_add_epi32(_mm256_mullo_epi32(first_y, row), first_x), still, 4);
+    __m256 active = _mm256_andnot_ps(still, _mm256_castsi256_ps(_mm256_set1_epi32(-1)));
     for (int k = 0; k < depth_search_texels && _mm256_movemask_ps(active) != 0; ++k) {
       const __m256 t_next = _mm256_min_ps(_mm256_min_ps(next_x, next_y), range);
       const __m256i index =
@@ -243,7 +236,7 @@ __attribute__((target("avx2"))) void crossings_avx2(const float* rays, int count
       next_x = _mm256_blendv_ps(next_x, _mm256_add_ps(next_x, delta_x), along_x);
       next_y = _mm256_blendv_ps(_mm256_add_ps(next_y, delta_y), next_y, along_x);
     }
-    _mm256_storeu_ps(out + i, _mm256_permutevar8x32_ps(result, ray_order()));
+    _mm256_storeu_ps(out + i, _mm256_permutevar8x32_ps(result, avx2::ray_order()));
   }
 }
 

@@ -78,7 +78,10 @@ class DisparitySurface {
   // The same search in the shader's float arithmetic, step for step (shaders/depth_search.glsl's
   // surface_hit), for the CPU depth-aware composite (compositor/cpu/composite_table.hpp): the δ / W
   // where the ray (flat point (u, v), gain (gain_u, gain_v)) meets the surface. Inline: it is that
-  // path's inner loop.
+  // path's inner loop. One difference: a ray that does not move (no gain: the display's black
+  // pixels, whose crossing no part of the picture takes) gives the texel it starts in at once,
+  // where the shader walks all depth_search_texels steps in place; on the CPU those steps were most
+  // of the search's time, on llvmpipe the early return cost more than it saved.
   float crossing(float u, float v, float gain_u, float gain_v) const;
   // crossing() of `count` rays, each four floats in `rays` (u, v, gain_u, gain_v), into `out`: eight
   // at a time with AVX2 where the CPU has it (the same operations in the same order, so the same
@@ -122,10 +125,13 @@ inline float DisparitySurface::crossing(float u, float v, float gain_u, float ga
   const float size[2] = {static_cast<float>(width_), static_cast<float>(height_)};
   const float start[2] = {(u + gain_u * front) * size[0], (v + gain_v * front) * size[1]};
   const float speed[2] = {-gain_u * size[0], -gain_v * size[1]};
-  const int tile_x = std::clamp(floor_index(start[0]), 0, width_ - 1) / depth_bound_tile;
-  const int tile_y = std::clamp(floor_index(start[1]), 0, height_ - 1) / depth_bound_tile;
-  const float bound = bounds_[static_cast<std::size_t>(tile_y) * bound_width_ + tile_x];
+  const int first_x = std::clamp(floor_index(start[0]), 0, width_ - 1);
+  const int first_y = std::clamp(floor_index(start[1]), 0, height_ - 1);
   const float fastest = greater(greater(std::fabs(speed[0]), std::fabs(speed[1])), 1.0e-30f);
+  // A ray that does not move (a black pixel: no gain) meets the surface in the texel it starts in.
+  if (!(fastest > 1.0e-30f)) return values_[static_cast<std::size_t>(first_y) * width_ + first_x];
+  const float bound =
+      bounds_[static_cast<std::size_t>(first_y / depth_bound_tile) * bound_width_ + first_x / depth_bound_tile];
   float t = lesser(lesser(front - bound, static_cast<float>(depth_bound_tile - 1) / fastest), range);
   int texel[2], step[2];
   float delta[2], next[2];

@@ -14,6 +14,8 @@
 #endif
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
+
+#include "optics/ray_lanes_avx2.hpp"
 #define NELF_TABLE_AVX2 1  // an AVX2 pass 1 where the CPU has it (Debian's x86-64 baseline is SSE2)
 #endif
 
@@ -729,15 +731,13 @@ __attribute__((target("avx2"), always_inline)) inline __m256i depth_tap_weight(_
 __attribute__((target("avx2"))) int depth_taps_avx2(const CompositeTable::DepthRay* rays, const float* hits, int count,
                                                     std::array<float, 2> scale, std::array<float, 2> offsets, int width,
                                                     int height, std::int32_t black, CompositeTable::Tap* out) {
-  const __m256i lanes = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
   const __m256 one = _mm256_set1_ps(1.f);
   const __m256i w_vector = _mm256_set1_epi32(width);
   int x = 0;
   for (; x + 8 <= count; x += 8) {
-    const float* r = &rays[x].u;
-    const __m256 u = _mm256_i32gather_ps(r, lanes, 4), v = _mm256_i32gather_ps(r + 1, lanes, 4);
-    const __m256 gain_u = _mm256_i32gather_ps(r + 2, lanes, 4), gain_v = _mm256_i32gather_ps(r + 3, lanes, 4);
-    const __m256 hit = _mm256_loadu_ps(hits + x);
+    // In load_rays' lane order; the taps go back into ray order before they are stored.
+    const auto [u, v, gain_u, gain_v] = avx2::load_rays(&rays[x].u);
+    const __m256 hit = _mm256_permutevar8x32_ps(_mm256_loadu_ps(hits + x), avx2::lane_order());
     __m256i lo_x, lo_y;
     const __m256 fx = depth_tap_axis(_mm256_add_ps(u, _mm256_mul_ps(gain_u, hit)), scale[0], offsets[0], width, lo_x);
     const __m256 fy = depth_tap_axis(_mm256_add_ps(v, _mm256_mul_ps(gain_v, hit)), scale[1], offsets[1], height, lo_y);
@@ -774,6 +774,8 @@ __attribute__((target("avx2"))) int depth_taps_avx2(const CompositeTable::DepthR
     const __m256i dark = _mm256_castps_si256(_mm256_cmp_ps(u, _mm256_set1_ps(-1.0e8f), _CMP_LT_OQ));
     texel = _mm256_blendv_epi8(texel, _mm256_set1_epi32(black), dark);
     weights = _mm256_andnot_si256(dark, weights);
+    texel = _mm256_permutevar8x32_epi32(texel, avx2::ray_order());
+    weights = _mm256_permutevar8x32_epi32(weights, avx2::ray_order());
     // Interleaved as taps (texel, weights): lanes 0 1 4 5 in `low`, 2 3 6 7 in `high`.
     const __m256i low = _mm256_unpacklo_epi32(texel, weights), high = _mm256_unpackhi_epi32(texel, weights);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + x), _mm256_permute2x128_si256(low, high, 0x20));

@@ -12,6 +12,8 @@
 #   FSAA     --fsaa for play (default 1)
 #   PROFILE  the device profile (default hmz-t1)
 # With PACING_LOGS=DIR the frame logs are kept there as log24.csv, log30.csv, log60.csv.
+# PACING_ARGS adds options to each play (e.g. "--depth estimate"); PACING_RATES picks the source
+# rates (default "24 30 60").
 # PACING_SCREEN=WxH sets the Xvfb screen (default 1920x1600, where the 1280x1470 window fits 1:1;
 # 1920x1080 gives a window scaled to fit, as on a 1080p desktop).
 set -euo pipefail
@@ -41,10 +43,10 @@ export DISPLAY=:$display_number
 
 echo "screen: ${PACING_SCREEN:-1920x1600}"
 echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg), LP_NUM_THREADS=$LP_NUM_THREADS"
-echo "command: nelf play CLIP --profile $profile --signal hdmi-fp-720p60 --fsaa $fsaa --log-frames LOG (DISPLAY=$DISPLAY, SDL_AUDIODRIVER=$SDL_AUDIODRIVER)"
+echo "command: nelf play CLIP --profile $profile --signal hdmi-fp-720p60 --fsaa $fsaa ${PACING_ARGS:+$PACING_ARGS }--log-frames LOG (DISPLAY=$DISPLAY, SDL_AUDIODRIVER=$SDL_AUDIODRIVER)"
 printf '| source | frames | shown | repeated | dropped | upload ms | composite ms | present ms | late >1 frame |\n'
 printf '|---|---|---|---|---|---|---|---|---|\n'
-for fps in 24 30 60; do
+for fps in ${PACING_RATES:-24 30 60}; do
   clip=$work/clip$fps.mp4
   # Half side-by-side: each 960x1080 half is a squeezed 1920x1080 view (moving test pattern).
   ffmpeg -nostdin -hide_banner -loglevel error -y \
@@ -54,8 +56,9 @@ for fps in 24 30 60; do
     -filter_complex "[0][1]hstack[v]" -map "[v]" -map 2:a \
     -c:v libx264 -preset veryfast -crf 20 -pix_fmt yuv420p -c:a aac -shortest "$clip"
   log=$work/log$fps.csv
+  # shellcheck disable=SC2086  # PACING_ARGS is a list of options
   summary=$("$nelf" play "$clip" --layout sbs-half --profile "$profile" --signal hdmi-fp-720p60 --fsaa "$fsaa" \
-    --log-frames "$log" --quiet 2>&1 | tail -1)
+    ${PACING_ARGS:-} --log-frames "$log" --quiet 2>&1 | tail -1)
   read -r shown repeated dropped < <(echo "$summary" | sed -E 's/.* ([0-9]+) frames shown, ([0-9]+) repeated, ([0-9]+) dropped.*/\1 \2 \3/')
   # Medians over the new frames (the first one compiles shaders and is left out).
   stats=$(awk -F, -v fps="$fps" 'NR > 2 && $2 == "shown" {
