@@ -230,7 +230,7 @@ std::shared_ptr<const CompositeSetup> FrameCompositor::ahead_setup(const FrameOv
     if (!worker_tables_) worker_tables_ = std::make_shared<std::array<std::optional<CompositeTable>, 2>>(tables_);
     setup_ = std::make_shared<const CompositeSetup>(
         CompositeSetup{worker_tables_, layout_.origins, packed, overlays.swap_eyes, grid, views_.width, views_.height,
-                       views_.block, views_.aspect, message, defects, depth});
+                       views_.block, views_.aspect, message, defects, depth, frame_surfaces_});
   }
   return setup_;
 }
@@ -444,8 +444,7 @@ void FrameCompositor::update_depth(const StereoVideoFrame& frame) {
   }
   if (frame.disparity != surfaces_from_) {
     try {
-      surfaces_ = {std::make_shared<const DisparitySurface>(frame.disparity->left),
-                   std::make_shared<const DisparitySurface>(frame.disparity->right)};
+      surfaces_ = frame_surfaces_->get(frame.disparity);
       surfaces_from_ = frame.disparity;
     } catch (const std::invalid_argument& e) {
       surfaces_ = {};

@@ -221,6 +221,7 @@ class FrameCompositor {
   // whether it is used; the one line said when it cannot be.
   std::shared_ptr<const StereoDisparity> surfaces_from_;
   std::array<std::shared_ptr<const DisparitySurface>, 2> surfaces_;
+  const std::shared_ptr<FrameSurfaces> frame_surfaces_ = std::make_shared<FrameSurfaces>();  // shared with the worker
   bool depth_frame_ = false;
   bool depth_notice_given_ = false;
   // The dead and stuck pixels of the profile's defect map hidden after compositing: per eye, the

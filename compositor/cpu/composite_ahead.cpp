@@ -163,21 +163,37 @@ bool CompositeAhead::composite(const CompositeSetup& setup, const StereoVideoFra
                             setup.message.get(), views_[i]);
   // The frame's depth as the display's thread takes it (FrameCompositor::update_depth): unusable
   // depth is the flat screen.
-  std::array<std::optional<DisparitySurface>, 2> surfaces;
-  if (setup.depth && frame.disparity) {
+  FrameSurfaces::Pair surfaces;
+  if (setup.depth && setup.surfaces && frame.disparity) {
     try {
-      surfaces[0].emplace(frame.disparity->left);
-      surfaces[1].emplace(frame.disparity->right);
+      surfaces = setup.surfaces->get(frame.disparity);
     } catch (const std::invalid_argument&) {
       surfaces = {};
     }
   }
-  const auto surface = [&](int i) { return surfaces[i] && surfaces[1 - i] ? &*surfaces[i] : nullptr; };
   render_packed_frame(*setup.tables, views, static_cast<std::size_t>(texture_w) * 4, setup.swap_eyes, setup.origins,
-                      setup.packed, out, {surface(0), surface(1)});
+                      setup.packed, out, {surfaces[0].get(), surfaces[1].get()});
   compensate_packed_eyes(setup.defects, setup.origins, out.pixels.data(), static_cast<std::size_t>(setup.packed[0]) * 4,
                          8);
   return true;
+}
+
+FrameSurfaces::Pair FrameSurfaces::get(const std::shared_ptr<const StereoDisparity>& disparity) {
+  const auto find = [&] {
+    return std::find_if(recent_.begin(), recent_.end(), [&](const auto& entry) { return entry.first == disparity; });
+  };
+  {
+    std::lock_guard lock(mutex_);
+    if (const auto found = find(); found != recent_.end()) return found->second;
+  }
+  // Made outside the lock (the other thread goes on meanwhile); if it made them too, its are kept.
+  Pair made{std::make_shared<const DisparitySurface>(disparity->left),
+            std::make_shared<const DisparitySurface>(disparity->right)};
+  std::lock_guard lock(mutex_);
+  if (const auto found = find(); found != recent_.end()) return found->second;
+  if (recent_.size() >= kept_) recent_.erase(recent_.begin());
+  recent_.emplace_back(disparity, made);
+  return made;
 }
 
 void compensate_packed_eyes(const EyeDefectPlans& plans,

@@ -30,6 +30,7 @@
 #include "core/frames.hpp"
 #include "core/image.hpp"
 #include "optics/defect_compensation.hpp"
+#include "optics/depth.hpp"
 
 namespace nelf {
 
@@ -46,6 +47,23 @@ void compensate_packed_eyes(const EyeDefectPlans& plans,
                             const std::array<std::optional<std::pair<int, int>>, 2>& origins, std::uint8_t* packed,
                             std::size_t stride, int bits);
 
+// The surfaces of the frames' disparities (per view), made once per frame and shared by the
+// display's thread and the worker: building one (its unknown texels filled, its front bounds) cost
+// about 0.6 ms a view, twice a frame when each thread made its own. Holds the last few frames'
+// disparities, so a depth source does not write their maps again while they are here.
+class FrameSurfaces {
+ public:
+  using Pair = std::array<std::shared_ptr<const DisparitySurface>, 2>;
+  // The surfaces of `disparity` (left, right). Throws std::invalid_argument as DisparitySurface
+  // does for maps that do not hold together (and keeps nothing for them).
+  Pair get(const std::shared_ptr<const StereoDisparity>& disparity);
+
+ private:
+  static constexpr std::size_t kept_ = 6;  // the frames composited ahead and the one shown, and some
+  std::mutex mutex_;
+  std::vector<std::pair<std::shared_ptr<const StereoDisparity>, Pair>> recent_;  // oldest first
+};
+
 struct CompositeSetup {
   std::shared_ptr<std::array<std::optional<CompositeTable>, 2>> tables;  // per eye
   std::array<std::optional<std::pair<int, int>>, 2> origins;             // panels' top-left corners
@@ -61,9 +79,10 @@ struct CompositeSetup {
   // The dead and stuck pixels hidden after compositing, per eye (plans for BGRA bytes), or none.
   EyeDefectPlans defects;
   // Frames that carry their depth are composited with it (the tables hold the depth-aware rays,
-  // CompositeTable::has_depth); a frame whose depth is unusable shows the flat screen, as on the
-  // display's thread.
+  // CompositeTable::has_depth), their surfaces from `surfaces`; a frame whose depth is unusable
+  // shows the flat screen, as on the display's thread.
   bool depth = false;
+  std::shared_ptr<FrameSurfaces> surfaces;
 };
 
 // The bytes a view is composited from: `view` itself, or, with a calibration `grid` or a `message`

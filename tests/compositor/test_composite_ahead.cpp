@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "compositor/cpu/composite_ahead.hpp"
@@ -37,8 +39,19 @@ std::shared_ptr<const CompositeSetup> make_setup(bool swap_eyes,
   auto tables = std::make_shared<std::array<std::optional<CompositeTable>, 2>>();
   (*tables)[0] = identity_table();
   (*tables)[1] = identity_table();
-  return std::make_shared<const CompositeSetup>(CompositeSetup{
-      tables, {std::pair{0, 0}, std::pair{2, 0}}, {3, 1}, swap_eyes, std::move(grid), 1, 1, {1, 1}, 0.0, nullptr, {}});
+  return std::make_shared<const CompositeSetup>(CompositeSetup{tables,
+                                                               {std::pair{0, 0}, std::pair{2, 0}},
+                                                               {3, 1},
+                                                               swap_eyes,
+                                                               std::move(grid),
+                                                               1,
+                                                               1,
+                                                               {1, 1},
+                                                               0.0,
+                                                               nullptr,
+                                                               {},
+                                                               false,
+                                                               nullptr});
 }
 
 using Pixel = std::array<int, 4>;
@@ -223,6 +236,34 @@ TEST(CompositeAhead, StopsWhileFramesAreWanted) {
     CompositeAhead ahead(2);
     ahead.want(setup, frames);
   }  // each destructor returns (the test would hang otherwise)
+}
+
+// Each frame's surfaces are made once, whichever thread asks first, and a frame's unusable depth
+// is refused each time it is asked for.
+TEST(FrameSurfaces, MadeOncePerDisparityAndSharedRefusingUnusableMaps) {
+  FrameSurfaces surfaces;
+  const auto disparity = [](float value) {
+    ViewDisparity map{4, 2, std::vector<float>(8, value)};
+    return std::make_shared<const StereoDisparity>(StereoDisparity{map, map, DisparityOrigin::estimated});
+  };
+  const auto first = disparity(1.f), second = disparity(2.f);
+  const FrameSurfaces::Pair a = surfaces.get(first);
+  ASSERT_TRUE(a[0] && a[1]);
+  EXPECT_EQ(surfaces.get(first), a);
+  const FrameSurfaces::Pair b = surfaces.get(second);
+  EXPECT_NE(b[0], a[0]);
+  EXPECT_EQ(b[0]->front(), 2.f / 4.f);
+  // From another thread: the same objects.
+  FrameSurfaces::Pair from_worker;
+  std::thread([&] { from_worker = surfaces.get(first); }).join();
+  EXPECT_EQ(from_worker, a);
+  const auto broken = std::make_shared<const StereoDisparity>(
+      StereoDisparity{ViewDisparity{4, 2, std::vector<float>(3)}, ViewDisparity{4, 2, std::vector<float>(8)}});
+  EXPECT_THROW(surfaces.get(broken), std::invalid_argument);
+  EXPECT_THROW(surfaces.get(broken), std::invalid_argument);
+  // Only the last few frames' are kept: an old one is made again, as new objects.
+  for (int i = 0; i < 10; ++i) surfaces.get(disparity(static_cast<float>(i)));
+  EXPECT_NE(surfaces.get(first)[0], a[0]);
 }
 
 }  // namespace
