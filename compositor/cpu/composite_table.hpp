@@ -12,6 +12,11 @@
 // this class only replays the box pass and the taps, with the arithmetic of GL's RGBA8 path
 // (8-bit intermediates, 8-bit bilinear weights). It agrees with the GL path to within a code value
 // or two (tests/compositor/gl/test_composite_table.cpp).
+//
+// With depth on, a table also holds what of each ray of the depth-aware composite does not change
+// from frame to frame (recorded the same way, by GL's depth coordinate map and depth strips); per
+// frame it searches each ray against the frame's surface and taps there, so frames with depth take
+// the CPU path too.
 #include <array>
 #include <cstddef>
 #include <cstdint>
