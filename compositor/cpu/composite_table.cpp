@@ -220,6 +220,26 @@ BoxAxis make_box_axis(int outputs, double origin, double spacing, double box, do
   return axis;
 }
 
+namespace {
+
+// One Pixel per border pixel of `r`, at its place in the panel, its four parts filled by
+// fill(pixel, index of the border pixel, part).
+template <class Pixel, class Fill>
+std::vector<Pixel> border_pixels(const CompositeTable::Recording& r, Fill fill) {
+  std::vector<Pixel> pixels;
+  pixels.reserve(r.border_pixels.size());
+  for (std::size_t i = 0; i < r.border_pixels.size(); ++i) {
+    Pixel pixel;
+    pixel.x = r.border_pixels[i] % r.panel[0];
+    pixel.y = r.border_pixels[i] / r.panel[0];
+    for (int k = 0; k < 4; ++k) fill(pixel, i, k);
+    pixels.push_back(pixel);
+  }
+  return pixels;
+}
+
+}  // namespace
+
 CompositeTable::Built CompositeTable::build(const Recording& r) {
   const std::size_t pixels = static_cast<std::size_t>(std::max(r.panel[0], 0)) * std::max(r.panel[1], 0);
   const bool borders_fit = std::all_of(r.border_pixels.begin(), r.border_pixels.end(),
@@ -236,18 +256,11 @@ CompositeTable::Built CompositeTable::build(const Recording& r) {
   b.taps.resize(pixels);
   for (std::size_t i = 0; i < pixels; ++i)
     b.taps[i] = make_tap(r.coordinates[2 * i], r.coordinates[2 * i + 1], r.prefiltered);
-  b.borders.reserve(r.border_pixels.size());
-  for (std::size_t i = 0; i < r.border_pixels.size(); ++i) {
-    BorderPixel pixel;
-    pixel.x = r.border_pixels[i] % r.panel[0];
-    pixel.y = r.border_pixels[i] / r.panel[0];
-    for (int k = 0; k < 4; ++k) {
-      const BorderPart& part = r.border_parts[i][k];
-      pixel.weights[k] = part.weight;
-      if (part.weight > 0.f) pixel.taps[k] = make_tap(part.x, part.y, r.prefiltered);
-    }
-    b.borders.push_back(pixel);
-  }
+  b.borders = border_pixels<BorderPixel>(r, [&](BorderPixel& pixel, std::size_t i, int k) {
+    const BorderPart& part = r.border_parts[i][k];
+    pixel.weights[k] = part.weight;
+    if (part.weight > 0.f) pixel.taps[k] = make_tap(part.x, part.y, r.prefiltered);
+  });
   if (r.depth) {
     const Recording::DepthRecording& d = *r.depth;
     if (d.rays.size() != 4 * pixels || d.border_parts.size() != r.border_pixels.size())
@@ -262,20 +275,13 @@ CompositeTable::Built CompositeTable::build(const Recording& r) {
     depth.rays.reserve(pixels);
     for (std::size_t i = 0; i < pixels; ++i)
       depth.rays.push_back(ray(d.rays[4 * i], d.rays[4 * i + 1], d.rays[4 * i + 2], d.rays[4 * i + 3]));
-    depth.borders.reserve(r.border_pixels.size());
-    for (std::size_t i = 0; i < r.border_pixels.size(); ++i) {
-      DepthBorderPixel pixel;
-      pixel.x = r.border_pixels[i] % r.panel[0];
-      pixel.y = r.border_pixels[i] / r.panel[0];
-      for (int k = 0; k < 4; ++k) {
-        const Recording::DepthPart& part = d.border_parts[i][k];
-        pixel.weights[k] = part.weight;
-        if (part.weight <= 0.f) continue;
-        pixel.rays[k] = ray(part.u, part.v, part.crossing_x, part.crossing_y);
-        pixel.hit_pixels[k] = part.hit_pixel;
-      }
-      depth.borders.push_back(pixel);
-    }
+    depth.borders = border_pixels<DepthBorderPixel>(r, [&](DepthBorderPixel& pixel, std::size_t i, int k) {
+      const Recording::DepthPart& part = d.border_parts[i][k];
+      pixel.weights[k] = part.weight;
+      if (part.weight <= 0.f) return;
+      pixel.rays[k] = ray(part.u, part.v, part.crossing_x, part.crossing_y);
+      pixel.hit_pixels[k] = part.hit_pixel;
+    });
     b.depth = std::move(depth);
   }
   return b;
