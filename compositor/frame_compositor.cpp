@@ -207,10 +207,12 @@ void FrameCompositor::forget_tables() {
 std::shared_ptr<const CompositeSetup> FrameCompositor::ahead_setup(const FrameOverlays& overlays,
                                                                    std::array<int, 2> packed) {
   if (!table_path_open() || !tables_tried_ || !(tables_[0] || tables_[1])) return nullptr;
-  bool depth = options_.depth != DepthMode::off && profile_.lens_array.has_value();
-  for (const auto& table : tables_) depth = depth && (!table || table->has_depth());
-  // Frames with depth that these tables cannot composite go to GL on the display's thread.
-  if (options_.depth != DepthMode::off && !depth) return nullptr;
+  // With depth on, the tables of a lens-array profile hold the depth-aware rays (recorded with
+  // them); frames with depth that tables without them cannot composite go to GL on this thread.
+  // A stock profile shows every frame flat.
+  const bool depth = options_.depth != DepthMode::off && profile_.lens_array.has_value();
+  for (const auto& table : tables_)
+    if (depth && table && !table->has_depth()) return nullptr;
   std::shared_ptr<const std::array<Image, 2>> grid;
   std::shared_ptr<const Image> message;
   EyeDefectPlans defects;
