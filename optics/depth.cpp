@@ -240,18 +240,13 @@ __attribute__((target("avx2"))) void crossings_avx2(const float* rays, int count
   }
 }
 
-bool cpu_has_avx2() {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
-}
-
 }  // namespace
 #endif
 
 void DisparitySurface::crossings(const float* rays, int count, float* out) const {
   int i = 0;
 #if defined(NELF_DEPTH_AVX2)
-  if (cpu_has_avx2() && front_ > back_) {
+  if (avx2::available() && front_ > back_) {
     i = count / 8 * 8;
     crossings_avx2(rays, i, out, values_.data(), bounds_.data(), width_, height_, bound_width_, front_, back_);
   }

@@ -3,11 +3,17 @@
 // composite table's DepthRay) as four AVX2 registers of one field each, for the code that searches
 // and taps eight rays at a time (optics/depth.cpp, compositor/cpu/composite_table.cpp). A 4×4
 // transpose within each 128-bit half: four gathers cost several times more on some CPUs (AMD's
-// Zen 2 among them). Only for x86-64 with GCC or Clang; the callers check the CPU.
+// Zen 2 among them). Only for x86-64 with GCC or Clang; the callers check the CPU (available()).
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 
 namespace nelf::avx2 {
+
+// Whether this CPU runs AVX2 code (Debian's x86-64 baseline is SSE2): asked once.
+inline bool available() {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+}
 
 struct RayLanes {
   __m256 u, v, gain_u, gain_v;  // lanes hold rays 0 2 4 6 1 3 5 7 (ray_order)

@@ -135,11 +135,6 @@ __attribute__((target("avx2"))) int replay_taps_avx2(const CompositeTable::Tap* 
   }
   return x;
 }
-
-bool has_avx2() {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
-}
 #endif
 
 // The box pass's two cells and their weights in one register: 16-bit [a, b] ×4 for _mm_madd_epi16.
@@ -178,7 +173,7 @@ void CompositeTable::replay_taps(const Tap* taps, int count, const std::uint8_t*
   static_assert(sizeof(Tap) == 8, "two taps are one 16-byte load");
   int x = 0;
 #if defined(NELF_TABLE_AVX2)
-  if (has_avx2()) x = replay_taps_avx2(taps, count, image, image_row, out);
+  if (avx2::available()) x = replay_taps_avx2(taps, count, image, image_row, out);
 #endif
 #if defined(__SSE2__)
   const __m128i round = _mm_set1_epi16(128);
@@ -819,7 +814,7 @@ void CompositeTable::render_depth(const DisparitySurface& surface, std::uint8_t*
     surface.crossings(&depth.rays[first].u, width, &hits_[first]);
     int x = 0;
 #if defined(NELF_TABLE_AVX2)
-    if (has_avx2())
+    if (avx2::available())
       x = depth_taps_avx2(&depth.rays[first], &hits_[first], width, depth.texture_scale, depth.texture_offset, image_w,
                           image_h, black.texel, row_taps_.data());
 #endif
