@@ -7,6 +7,7 @@
 #include <future>
 #include <stdexcept>
 
+#include "compositor/cpu/depth_taps.hpp"
 #include "optics/depth.hpp"
 
 #if defined(__SSE2__)
@@ -664,172 +665,33 @@ void CompositeTable::render(const std::uint8_t* reduced, std::size_t reduced_str
   }
 }
 
-namespace {
-
-// make_tap in float and without branches on the data, for the depth-aware pass's taps (made per
-// pixel per frame; make_tap's double arithmetic and its branches cost as much as the search). The
-// same rounding: each product in 8 bits, the largest taking the rest. GL's clamp to edge at the
-// image's sides (its margin is black there), any coordinate (NaN and infinities too) held inside.
-inline CompositeTable::Tap depth_tap(float u, float v, int width, int height) {
-  const auto axis = [](float coordinate, int size, int& lo) {
-    float c = coordinate * static_cast<float>(size) - 0.5f;
-    c = c > -1.f ? c : -1.f;
-    c = c < static_cast<float>(size) ? c : static_cast<float>(size);
-    const int i = static_cast<int>(c + 1.f) - 1;  // floor, c ≥ -1
-    lo = i < 0 ? 0 : i < size - 1 ? i : size - 1;
-    return i >= 0 && i < size - 1 ? c - static_cast<float>(i) : 0.f;
-  };
-  int lo_x, lo_y;
-  const float fx = axis(u, width, lo_x), fy = axis(v, height, lo_y);
-  const float e0 = (1.f - fx) * (1.f - fy), e1 = fx * (1.f - fy), e2 = (1.f - fx) * fy, e3 = fx * fy;
-  const int w0 = static_cast<int>(e0 * 256.f + 0.5f), w1 = static_cast<int>(e1 * 256.f + 0.5f),
-            w2 = static_cast<int>(e2 * 256.f + 0.5f), w3 = static_cast<int>(e3 * 256.f + 0.5f);
-  // The largest product (the first of equals, as make_tap) takes what rounding left over.
-  const int a = e1 > e0 ? 1 : 0, b = e3 > e2 ? 3 : 2;
-  const float ea = a ? e1 : e0, eb = b == 3 ? e3 : e2;
-  const int largest = eb > ea ? b : a;
-  const int rest = 256 - (w0 + w1 + w2 + w3);
-  // The four weights as one word (bytes in tap order), built in registers: writing a Tap's bytes
-  // one by one and reading the Tap back as 8 bytes stalls on store forwarding.
-  const std::uint32_t word = static_cast<std::uint32_t>(w0) | static_cast<std::uint32_t>(w1) << 8 |
-                             static_cast<std::uint32_t>(w2) << 16 | static_cast<std::uint32_t>(w3) << 24;
-  const std::uint32_t fixed = word + (static_cast<std::uint32_t>(rest) << (8 * largest));
-  const int top = static_cast<int>((fixed >> (8 * largest)) & 0xffu);
-  // All the weight on one texel (the byte wrapped to 0 from 256): that texel's tap alone.
-  const bool alone = top == 0 && ((largest == 0 ? w0 : largest == 1 ? w1 : largest == 2 ? w2 : w3) + rest) == 256;
-  const std::int32_t offset = largest == 0 ? 0 : largest == 1 ? 1 : largest == 2 ? width : width + 1;
-  CompositeTable::Tap tap;
-  tap.texel = lo_y * width + lo_x + (alone ? offset : 0);
-  const std::uint32_t weights = alone ? 0u : fixed;
-  std::memcpy(tap.weights.data(), &weights, 4);
-  return tap;
-}
-
-#if defined(NELF_TABLE_AVX2)
-// One axis of depth_tap() for eight coordinates: the clamped first texel and the fraction towards
-// the next (0 where they coincide).
-__attribute__((target("avx2"), always_inline)) inline __m256 depth_tap_axis(__m256 coordinate, float scale,
-                                                                            float offset, int size, __m256i& lo) {
-  const __m256 size_f = _mm256_set1_ps(static_cast<float>(size));
-  __m256 c = _mm256_sub_ps(
-      _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(coordinate, _mm256_set1_ps(scale)), _mm256_set1_ps(offset)), size_f),
-      _mm256_set1_ps(0.5f));
-  c = _mm256_max_ps(c, _mm256_set1_ps(-1.f));  // NaN to -1, as c > -1 ? c : -1
-  c = _mm256_min_ps(c, size_f);                // as c < size ? c : size
-  const __m256i i = _mm256_sub_epi32(_mm256_cvttps_epi32(_mm256_add_ps(c, _mm256_set1_ps(1.f))), _mm256_set1_epi32(1));
-  const __m256i zero = _mm256_setzero_si256(), last = _mm256_set1_epi32(size - 1);
-  lo = _mm256_min_epi32(_mm256_max_epi32(i, zero), last);
-  const __m256i inside = _mm256_andnot_si256(_mm256_cmpgt_epi32(zero, i), _mm256_cmpgt_epi32(last, i));
-  return _mm256_and_ps(_mm256_sub_ps(c, _mm256_cvtepi32_ps(i)), _mm256_castsi256_ps(inside));
-}
-// A product's 8-bit weight, rounded half up (e ≥ 0).
-__attribute__((target("avx2"), always_inline)) inline __m256i depth_tap_weight(__m256 e) {
-  return _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(e, _mm256_set1_ps(256.f)), _mm256_set1_ps(0.5f)));
-}
-
-// depth_tap() for eight rays a register (the same operations, so the same taps), black rays (u <
-// -1e8) the `black` texel alone; writes count / 8 * 8 taps and returns how many.
-__attribute__((target("avx2"))) int depth_taps_avx2(const CompositeTable::DepthRay* rays, const float* hits, int count,
-                                                    std::array<float, 2> scale, std::array<float, 2> offsets, int width,
-                                                    int height, std::int32_t black, CompositeTable::Tap* out) {
-  const __m256 one = _mm256_set1_ps(1.f);
-  const __m256i w_vector = _mm256_set1_epi32(width);
-  int x = 0;
-  for (; x + 8 <= count; x += 8) {
-    // In load_rays' lane order; the taps go back into ray order before they are stored.
-    const auto [u, v, gain_u, gain_v] = avx2::load_rays(&rays[x].u);
-    const __m256 hit = _mm256_permutevar8x32_ps(_mm256_loadu_ps(hits + x), avx2::lane_order());
-    __m256i lo_x, lo_y;
-    const __m256 fx = depth_tap_axis(_mm256_add_ps(u, _mm256_mul_ps(gain_u, hit)), scale[0], offsets[0], width, lo_x);
-    const __m256 fy = depth_tap_axis(_mm256_add_ps(v, _mm256_mul_ps(gain_v, hit)), scale[1], offsets[1], height, lo_y);
-    const __m256 gx = _mm256_sub_ps(one, fx), gy = _mm256_sub_ps(one, fy);
-    const __m256 e0 = _mm256_mul_ps(gx, gy), e1 = _mm256_mul_ps(fx, gy), e2 = _mm256_mul_ps(gx, fy),
-                 e3 = _mm256_mul_ps(fx, fy);
-    const __m256i w0 = depth_tap_weight(e0), w1 = depth_tap_weight(e1), w2 = depth_tap_weight(e2),
-                  w3 = depth_tap_weight(e3);
-    // The largest (the first of equals): a of the first pair, b of the second, then between them.
-    const __m256 a_is_1 = _mm256_cmp_ps(e1, e0, _CMP_GT_OQ), b_is_3 = _mm256_cmp_ps(e3, e2, _CMP_GT_OQ);
-    const __m256 ea = _mm256_blendv_ps(e0, e1, a_is_1), eb = _mm256_blendv_ps(e2, e3, b_is_3);
-    const __m256 b_wins = _mm256_cmp_ps(eb, ea, _CMP_GT_OQ);
-    const __m256i a = _mm256_and_si256(_mm256_castps_si256(a_is_1), _mm256_set1_epi32(1));
-    const __m256i b =
-        _mm256_add_epi32(_mm256_set1_epi32(2), _mm256_and_si256(_mm256_castps_si256(b_is_3), _mm256_set1_epi32(1)));
-    const __m256i largest =
-        _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(a), _mm256_castsi256_ps(b), b_wins));
-    const __m256i wa = _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(w0), _mm256_castsi256_ps(w1), a_is_1));
-    const __m256i wb = _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(w2), _mm256_castsi256_ps(w3), b_is_3));
-    const __m256i w_largest =
-        _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(wa), _mm256_castsi256_ps(wb), b_wins));
-    const __m256i rest =
-        _mm256_sub_epi32(_mm256_set1_epi32(256), _mm256_add_epi32(_mm256_add_epi32(w0, w1), _mm256_add_epi32(w2, w3)));
-    const __m256i word = _mm256_or_si256(_mm256_or_si256(w0, _mm256_slli_epi32(w1, 8)),
-                                         _mm256_or_si256(_mm256_slli_epi32(w2, 16), _mm256_slli_epi32(w3, 24)));
-    const __m256i fixed = _mm256_add_epi32(word, _mm256_sllv_epi32(rest, _mm256_slli_epi32(largest, 3)));
-    const __m256i alone = _mm256_cmpeq_epi32(_mm256_add_epi32(w_largest, rest), _mm256_set1_epi32(256));
-    // The offset of texel `largest` from the first: 0, 1, a row, a row and one.
-    const __m256i offset = _mm256_add_epi32(_mm256_and_si256(largest, _mm256_set1_epi32(1)),
-                                            _mm256_mullo_epi32(_mm256_srli_epi32(largest, 1), w_vector));
-    __m256i texel =
-        _mm256_add_epi32(_mm256_add_epi32(_mm256_mullo_epi32(lo_y, w_vector), lo_x), _mm256_and_si256(offset, alone));
-    __m256i weights = _mm256_andnot_si256(alone, fixed);
-    const __m256i dark = _mm256_castps_si256(_mm256_cmp_ps(u, _mm256_set1_ps(-1.0e8f), _CMP_LT_OQ));
-    texel = _mm256_blendv_epi8(texel, _mm256_set1_epi32(black), dark);
-    weights = _mm256_andnot_si256(dark, weights);
-    texel = _mm256_permutevar8x32_epi32(texel, avx2::ray_order());
-    weights = _mm256_permutevar8x32_epi32(weights, avx2::ray_order());
-    // Interleaved as taps (texel, weights): lanes 0 1 4 5 in `low`, 2 3 6 7 in `high`.
-    const __m256i low = _mm256_unpacklo_epi32(texel, weights), high = _mm256_unpackhi_epi32(texel, weights);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + x), _mm256_permute2x128_si256(low, high, 0x20));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + x + 4), _mm256_permute2x128_si256(low, high, 0x31));
-  }
-  return x;
-}
-#endif
-
-}  // namespace
-
 // The depth-aware composite (shaders/elemental_depth_lookup.frag, then the border strips of
 // elemental.frag with NELF_DEPTH_HITS): per pixel the search for where its ray meets the surface and
-// one tap there, made as a tap of the flat table (make_tap) and replayed a row at a time with the
-// same arithmetic; then the border pixels, each part through its lens where its ray meets the
-// surface at the crossing its hit pixel found. Pass 1 goes first over all rows: a part may take a
-// crossing from the row below.
+// one tap there (depth_taps.hpp), replayed a row at a time with the flat table's arithmetic; then
+// the border pixels, each part through its lens where its ray meets the surface at the crossing its
+// hit pixel found. Pass 1 goes first over all rows: a part may take a crossing from the row below.
 void CompositeTable::render_depth(const DisparitySurface& surface, std::uint8_t* out, std::size_t out_stride) {
   const DepthTable& depth = *built_.depth;
   const std::uint8_t* image = image_.data();
   const std::size_t image_row = static_cast<std::size_t>(built_.prefiltered[0]) * 4;
   const int width = built_.panel[0];
-  const auto [scale_u, scale_v] = depth.texture_scale;
-  const auto [offset_u, offset_v] = depth.texture_offset;
-  const int image_w = built_.prefiltered[0], image_h = built_.prefiltered[1];
-  const CompositeTable::Tap black = make_tap(-1.f, -1.f, built_.prefiltered);
-  const auto tap_at = [&](const DepthRay& ray, float hit) {
-    return depth_tap((ray.u + ray.gain_u * hit) * scale_u + offset_u, (ray.v + ray.gain_v * hit) * scale_v + offset_v,
-                     image_w, image_h);
-  };
+  const DepthTapImage taps_read{built_.prefiltered, depth.texture_scale, depth.texture_offset};
+  const Tap black = make_tap(-1.f, -1.f, built_.prefiltered);
   static_assert(sizeof(DepthRay) == 4 * sizeof(float), "a row of rays is four floats a ray");
   for (int y = 0; y < built_.panel[1]; ++y) {
     const std::size_t first = static_cast<std::size_t>(y) * width;
-    // The row's searches at once (black pixels too, without a branch: their result is dropped).
+    // The row's searches at once (black pixels too, without a branch: their taps are the black
+    // texel, and their crossings, as GL's, are kept for the strips).
     surface.crossings(&depth.rays[first].u, width, &hits_[first]);
-    int x = 0;
-#if defined(NELF_TABLE_AVX2)
-    if (avx2::available())
-      x = depth_taps_avx2(&depth.rays[first], &hits_[first], width, depth.texture_scale, depth.texture_offset, image_w,
-                          image_h, black.texel, row_taps_.data());
-#endif
-    for (; x < width; ++x) {
-      const DepthRay& ray = depth.rays[first + x];
-      // A black pixel of the display: the black texel (its crossing, as GL's, is kept for the strips).
-      row_taps_[x] = ray.u < -1.0e8f ? black : tap_at(ray, hits_[first + x]);
-    }
+    depth_taps(&depth.rays[first], &hits_[first], width, taps_read, black, row_taps_.data());
     replay_taps(row_taps_.data(), width, image, image_row, out + static_cast<std::size_t>(y) * out_stride);
   }
   for (const DepthBorderPixel& b : depth.borders) {
     BorderPixel pixel;
     pixel.weights = b.weights;
     for (int k = 0; k < 4; ++k)
-      if (b.weights[k] > 0.f) pixel.taps[k] = tap_at(b.rays[k], hits_[static_cast<std::size_t>(b.hit_pixels[k])]);
+      if (b.weights[k] > 0.f)
+        pixel.taps[k] = depth_tap(b.rays[k], hits_[static_cast<std::size_t>(b.hit_pixels[k])], taps_read);
     border_pixel(pixel, image, image_row,
                  out + static_cast<std::size_t>(b.y) * out_stride + 4 * static_cast<std::size_t>(b.x));
   }

@@ -96,8 +96,6 @@ class CompositeTable {
     std::array<Tap, 4> taps;
     std::array<float, 4> weights{};  // per part; ≤ 0: no part
   };
-  // What render() replays, built from a Recording (what a CompositeTableCache keeps: a table loaded
-  // from it needs no make_tap per pixel).
   // A ray of the depth-aware composite: where it meets the flat screen (uv; u < -1e8: a black
   // pixel) and its uv shift per unit of δ / W (the pupil crossing times the parallax gain).
   struct DepthRay {
@@ -114,6 +112,8 @@ class CompositeTable {
     std::vector<DepthBorderPixel> borders;  // pass 2
     std::array<float, 2> texture_scale{1.f, 1.f}, texture_offset{0.f, 0.f};
   };
+  // What render() replays, built from a Recording (what a CompositeTableCache keeps: a table loaded
+  // from it needs no make_tap per pixel).
   struct Built {
     std::array<int, 2> panel{0, 0}, reduced{0, 0}, prefiltered{0, 0};  // as in Recording
     BoxAxis horizontal, vertical;
